@@ -1,0 +1,113 @@
+"""Argument checks shared by the public API.
+
+Every check raises ``ValueError`` naming the argument and the expected form, so
+that a user sees at once which input is wrong and what it should have been.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+__all__ = [
+    "AliasingWarning",
+    "as_axis",
+    "as_finite_complex",
+    "as_position",
+    "check_frequency",
+    "check_nonnegative_ranges",
+    "uniform_step",
+]
+
+
+class AliasingWarning(UserWarning):
+    """The element pitch exceeds half a wavelength: steep waves alias."""
+
+
+def check_frequency(frequency: float, name: str = "frequency") -> float:
+    """Return ``frequency`` as a float after checking it is finite and > 0 (Hz)."""
+    try:
+        f = float(frequency)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a positive number in Hz, got {frequency!r}") from None
+    if not np.isfinite(f) or f <= 0:
+        raise ValueError(f"{name} must be a positive finite number in Hz, got {frequency!r}")
+    return f
+
+
+def as_finite_complex(data: object, name: str, *, min_ndim: int = 0) -> np.ndarray:
+    """Return a complex copy-free view of ``data``, refusing NaN and inf."""
+    arr = np.asarray(data)
+    if not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool):
+        raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
+    if arr.ndim < min_ndim:
+        raise ValueError(f"{name} must have at least {min_ndim} dimensions, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite: it contains NaN or inf values")
+    if not np.iscomplexobj(arr):
+        arr = arr.astype(np.complex128)
+    return arr
+
+
+def as_axis(values: object, name: str, *, length: int | None = None) -> np.ndarray:
+    """Return a strictly increasing, finite 1-D float axis (metres)."""
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim != 1 or arr.size < 1:
+        raise ValueError(f"{name} must be a 1-D sequence of coordinates in metres, got shape "
+                         f"{arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite coordinates in metres")
+    if length is not None and arr.size != length:
+        raise ValueError(f"{name} must have {length} values to match the data, got {arr.size}")
+    if arr.size > 1 and np.any(np.diff(arr) <= 0):
+        raise ValueError(f"{name} must be strictly increasing")
+    return arr
+
+
+def uniform_step(axis: np.ndarray, name: str, *, rtol: float = 1e-6) -> float:
+    """Return the step of a uniform axis, or raise if it is not uniform.
+
+    A single-sample axis has no step; it is reported as ``nan`` and callers
+    that need a step must refuse it.
+    """
+    if axis.size < 2:
+        raise ValueError(f"{name} must hold at least 2 uniformly spaced samples, got {axis.size}")
+    d = np.diff(axis)
+    step = float(np.mean(d))
+    if np.max(np.abs(d - step)) > rtol * abs(step):
+        raise ValueError(f"{name} must be uniformly spaced for FFT propagation; its steps range "
+                         f"from {d.min():.6g} to {d.max():.6g} m")
+    return step
+
+
+def check_nonnegative_ranges(z: object, name: str = "z") -> np.ndarray:
+    """Return ranges ``z`` (metres, from the aperture) as a 1-D float array, refusing z < 0."""
+    arr = np.atleast_1d(np.asarray(z, dtype=float))
+    if arr.ndim != 1 or arr.size == 0:
+        raise ValueError(f"{name} must be a range in metres or a 1-D sequence of them")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite ranges in metres")
+    if np.any(arr < 0):
+        raise ValueError(f"{name} must be >= 0 (range from the aperture plane towards the scene, "
+                         f"metres); got min {arr.min():.6g}")
+    return arr
+
+
+def as_position(position: Sequence[float] | np.ndarray, name: str = "position") -> np.ndarray:
+    """Return an (x, y, z) position in metres as a float array of shape (3,)."""
+    arr = np.asarray(position, dtype=float)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be three finite coordinates (x, y, z) in metres, got "
+                         f"{position!r}")
+    return arr
+
+
+def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture") -> None:
+    """Warn (and go on) when a sampling pitch exceeds half a wavelength."""
+    if pitch > wavelength / 2 * (1 + 1e-9):
+        theta = np.degrees(np.arcsin(min(1.0, wavelength / (2 * pitch))))
+        warnings.warn(f"{what} pitch {pitch * 100:.3g} cm exceeds lambda/2 = "
+                      f"{wavelength * 50:.3g} cm: waves arriving more than {theta:.1f} degrees "
+                      f"off axis alias", AliasingWarning, stacklevel=3)

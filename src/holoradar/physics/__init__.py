@@ -1,0 +1,1 @@
+"""Physics layer: media, sources and propagators (forward and adjoint)."""

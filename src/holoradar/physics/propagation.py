@@ -1,0 +1,248 @@
+"""Propagators between the aperture plane (z = 0) and image planes at range z.
+
+Two families, each a linear operator with a forward and an adjoint:
+
+* :class:`AngularSpectrum` — exact, non-paraxial: every plane-wave component
+  ``(p, q)`` is carried by the stack transfer ``U(p, q; z)`` of
+  :meth:`Medium.vertical_transfer` (``exp(i*kz*z)`` in free space). Forward maps
+  an up-going field at range z to the aperture; the adjoint multiplies by
+  ``conj(U)``, which is migration (PHYSICS.md section 2): exact inverse on the
+  propagating band in a lossless medium, decaying (stable) on evanescent waves.
+* :class:`Fresnel` — the paper's paraxial Eq. 3 as a sampled convolution with
+  the Fresnel kernel ``(k/(2*pi*i*L)) * exp(i*k*(x^2 + y^2)/(2*L))`` times the
+  normal-incidence stack transfer; ``L`` is the apparent distance (PHYSICS.md
+  section 6). Its adjoint convolves with the conjugate kernel.
+
+Fourier convention: ``F(p, q) = sum f(x, y) exp(-i*(p*x + q*y))`` (numpy's
+forward FFT); the pair of FFTs is exactly unitary up to the usual 1/N, so
+forward and adjoint are exact adjoints of each other, padding and cropping
+included (zero-padding's adjoint is cropping). Zero padding (``pad=True``:
+at least twice each size) keeps the periodic FFT from wrapping the image.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from functools import lru_cache
+
+import numpy as np
+import scipy.fft as sfft
+
+from .medium import Medium
+
+__all__ = ["AngularSpectrum", "Fresnel", "lateral_travel", "padded_shape", "spectral_axes"]
+
+
+def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[float, float]
+                 | None = None, wavelength: float | None = None,
+                 z_max: float = 0.0) -> tuple[int, int]:
+    """FFT grid for an ``(ny, nx)`` field.
+
+    ``pad=False``: no padding (periodic). A float: that factor. ``pad=True``: at
+    least twice each size, and at least ``lambda*z_max/dx^2`` samples: the
+    angular spectrum samples its transfer phase ``kz*z`` every
+    ``dp = 2*pi/(M*dx)``, and at the band edge ``p = pi/dx`` that phase turns by
+    ``z*p*dp/k`` per sample, which stays below pi only when
+    ``M >= lambda*z/dx^2`` (the critical distance ``z_c = M*dx^2/lambda`` of
+    Voelz & Roggemann 2009). Beyond it the transfer function aliases.
+    """
+    if pad is True:
+        dims = []
+        for n, d in zip(shape, pitch[::-1] if pitch else (None, None), strict=True):
+            m = 2 * n
+            if d is not None and wavelength is not None:
+                m = max(m, int(np.ceil(wavelength * z_max / d**2)))
+            dims.append(sfft.next_fast_len(m, real=False))
+        return tuple(dims)
+    factor = 1.0 if pad is False else float(pad)
+    if not np.isfinite(factor) or factor < 1:
+        raise ValueError(f"pad must be True, False or a factor >= 1, got {pad!r}")
+    if factor == 1:
+        return tuple(shape)
+    return tuple(sfft.next_fast_len(int(np.ceil(factor * n)), real=False) for n in shape)
+
+
+def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndarray, np.ndarray]:
+    """Transverse wavenumbers ``(p, q)`` in rad/m of an FFT grid of ``shape = (ny, nx)``."""
+    ny, nx = shape
+    return (2 * np.pi * sfft.fftfreq(nx, dx), 2 * np.pi * sfft.fftfreq(ny, dy))
+
+
+def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
+    """Lateral distance per unit transverse wavenumber, ``sum_j h_j / Re(kz_j)`` (m^2/rad).
+
+    A component (p, q) travelling from range ``z`` to the aperture shifts laterally
+    by ``p * travel`` along x and ``q * travel`` along y (the group delay of its
+    phase, ``d(phase)/dp``). Evanescent components get ``inf``.
+    """
+    kappa2 = np.asarray(kappa2, dtype=float)
+    travel = np.zeros(np.shape(kappa2))
+    j = medium.region_of(z)
+    for m in range(j + 1):
+        top = medium.top_of(m)
+        bottom = z if m == j else medium.z_interfaces[m]
+        if bottom <= top:
+            continue
+        kz = medium.kz(k, kappa2, m).real
+        with np.errstate(divide="ignore"):
+            travel = travel + np.where(kz > 0, (bottom - top) / np.where(kz > 0, kz, 1), np.inf)
+    return travel
+
+
+@lru_cache(maxsize=64)
+def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
+                      medium: Medium, band_limit: bool) -> np.ndarray:
+    p, q = spectral_axes(shape, dx, dy)
+    kappa2 = q[:, None] ** 2 + p[None, :] ** 2
+    U = medium.vertical_transfer(k, kappa2, z, 0.0)
+    if band_limit:
+        # Band-limited angular spectrum (Matsushima & Shimobaba 2009): the phase of U
+        # is sampled every dp = 2*pi/(M*dx); a component whose lateral shift p*travel
+        # exceeds half the FFT grid, M*dx/2, is aliased (it would wrap around), and
+        # it cannot join a pixel and an element inside the grid anyway. Drop it.
+        ny, nx = shape
+        t = lateral_travel(k, medium, kappa2, z)
+        with np.errstate(invalid="ignore"):  # 0 * inf at p = 0 for evanescent rows
+            ok = ((np.abs(p[None, :]) * t <= nx * dx / 2)
+                  & (np.abs(q[:, None]) * t <= ny * dy / 2))
+        U = np.where(ok | (kappa2 > k * k), U, 0)
+    U.setflags(write=False)
+    return U
+
+
+class _PlaneOperator(ABC):
+    """Shared pad / FFT / crop machinery of the propagators."""
+
+    def __init__(self, shape: tuple[int, int], dx: float, dy: float, k: float,
+                 z: float | Sequence[float], medium: Medium | None = None,
+                 pad: bool | float = True, dtype: type = np.complex128, *,
+                 band_limit: bool = True) -> None:
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.dx, self.dy, self.k = float(dx), float(dy), float(k)
+        self.z = np.atleast_1d(np.asarray(z, dtype=float))
+        self.medium = medium if medium is not None else Medium.free_space()
+        self.fft_shape = padded_shape(self.shape, pad, pitch=(self.dx, self.dy),
+                                      wavelength=2 * np.pi / self.k,
+                                      z_max=float(self.z.max(initial=0.0)))
+        self.dtype = np.dtype(dtype)
+        self.band_limit = bool(band_limit)
+        self._transfers: list[np.ndarray] | None = None
+
+    # The transfer function of each plane, cast once to the working dtype.
+    @property
+    def transfers(self) -> list[np.ndarray]:
+        if self._transfers is None:
+            self._transfers = [self._transfer(float(z)).astype(self.dtype, copy=False)
+                               for z in self.z]
+        return self._transfers
+
+    @abstractmethod
+    def _transfer(self, z: float) -> np.ndarray:
+        """Transfer function of the plane at range ``z`` on the FFT grid."""
+
+    def _fft(self, a: np.ndarray) -> np.ndarray:
+        return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=-1)
+
+    def _ifft_crop(self, A: np.ndarray) -> np.ndarray:
+        ny, nx = self.shape
+        return sfft.ifft2(A, axes=(-2, -1), workers=-1)[..., :ny, :nx]
+
+    def spectrum(self, data: np.ndarray) -> np.ndarray:
+        """Padded 2-D FFT of ``data`` (..., ny, nx) in the working dtype."""
+        data = np.asarray(data)
+        if data.shape[-2:] != self.shape:
+            raise ValueError(f"data must end in shape {self.shape}, got {data.shape}")
+        return self._fft(data.astype(self.dtype, copy=False))
+
+    def forward(self, field: np.ndarray) -> np.ndarray:
+        """Fields at the planes ``z`` (..., nz, ny, nx) -> field at the aperture (..., ny, nx).
+
+        The contributions of all planes add (a volume of sources radiating up).
+        """
+        field = np.asarray(field)
+        if field.ndim < 3 or field.shape[-3] != self.z.size:
+            raise ValueError(f"field must have shape (..., {self.z.size}, ny, nx)")
+        F = self.spectrum(field)
+        acc = np.zeros(F.shape[:-3] + self.fft_shape, dtype=F.dtype)
+        for i, U in enumerate(self.transfers):
+            acc += F[..., i, :, :] * U
+        return self._ifft_crop(acc)
+
+    def adjoint(self, hologram: np.ndarray) -> np.ndarray:
+        """Aperture field (..., ny, nx) -> back-propagated fields (..., nz, ny, nx)."""
+        H = self.spectrum(hologram)
+        out = np.empty((*H.shape[:-2], self.z.size, *self.shape), dtype=self.dtype)
+        for i, U in enumerate(self.transfers):
+            out[..., i, :, :] = self._ifft_crop(H * U.conj())
+        return out
+
+
+class AngularSpectrum(_PlaneOperator):
+    """Exact angular-spectrum propagator through a layered medium.
+
+    Parameters
+    ----------
+    shape : (int, int)
+        ``(ny, nx)`` of the sampled fields.
+    dx, dy : float
+        Sample pitch, metres.
+    k : float
+        Wavenumber in air, rad/m.
+    z : float or sequence of float
+        Ranges of the image planes, metres (>= 0).
+    medium : Medium, optional
+        Layered medium (default free space).
+    pad : bool or float
+        Zero padding (:func:`padded_shape`): ``True`` at least doubles each size
+        and keeps the transfer function sampled; a float is the factor.
+    dtype : numpy dtype
+        ``complex128`` (default) or ``complex64`` for speed.
+    band_limit : bool
+        Drop the components whose lateral shift exceeds half the FFT grid
+        (band-limited angular spectrum, default True): they would wrap around.
+        Evanescent components are kept (they decay).
+
+    Examples
+    --------
+    >>> op = AngularSpectrum((32, 32), 0.01, 0.01, 2 * np.pi / 0.03, 0.2)
+    >>> img = op.adjoint(np.ones((32, 32)))
+    >>> img.shape
+    (1, 32, 32)
+    """
+
+    def _transfer(self, z: float) -> np.ndarray:
+        return _angular_transfer(self.fft_shape, self.dx, self.dy, self.k, z, self.medium,
+                                 self.band_limit)
+
+
+class Fresnel(_PlaneOperator):
+    """Paraxial Fresnel-Kirchhoff propagator (the paper's Eq. 3), sampled convolution.
+
+    Same parameters as :class:`AngularSpectrum`. The kernel is sampled on the
+    grid, ``K = T0 * (k/(2*pi*i*L)) * exp(i*k*r^2/(2*L)) * dx*dy``, with ``L`` the
+    apparent distance of the plane and ``T0`` the normal-incidence stack transfer
+    (``exp(i*k*z)`` in free space). Use ``pad=True`` for a linear convolution.
+    The kernel is cut where its local frequency ``k*|x|/L`` exceeds the grid's
+    Nyquist ``pi/dx`` (beyond, the sampled chirp would alias).
+    """
+
+    def _transfer(self, z: float) -> np.ndarray:
+        if z <= 0:
+            raise ValueError("the Fresnel kernel needs z > 0")
+        My, Mx = self.fft_shape
+        # Sample offsets in FFT order so that the circular convolution is linear
+        # on the cropped output when the grid is padded to >= 2n - 1.
+        ox = np.fft.fftfreq(Mx, 1.0 / Mx) * self.dx
+        oy = np.fft.fftfreq(My, 1.0 / My) * self.dy
+        L = self.medium.apparent_distance(z)
+        T0 = complex(self.medium.vertical_transfer(self.k, np.array(0.0), z, 0.0))
+        r2 = oy[:, None] ** 2 + ox[None, :] ** 2
+        kern = (T0 * self.k / (2j * np.pi * L) * np.exp(1j * self.k * r2 / (2 * L))
+                * self.dx * self.dy)
+        # The chirp's local frequency k*|x|/L must stay below the grid's Nyquist
+        # pi/dx; beyond it the sampled kernel aliases, so it is cut there (the
+        # sampling limit of the impulse-response method).
+        kern = np.where((np.abs(ox[None, :]) * self.k / L <= np.pi / self.dx)
+                        & (np.abs(oy[:, None]) * self.k / L <= np.pi / self.dy), kern, 0)
+        return sfft.fft2(kern, workers=-1)
