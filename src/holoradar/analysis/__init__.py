@@ -1,0 +1,1 @@
+"""Analysis: closed-form theory and image metrics."""

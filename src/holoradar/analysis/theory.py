@@ -1,0 +1,266 @@
+"""Closed-form theory of holographic imaging (PHYSICS.md sections 4, 6).
+
+All lengths in metres, frequencies in Hz, angles in radians, wavenumbers in
+rad/m. Apertures are FULL widths A, B (half-widths a = A/2, b = B/2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+from scipy.special import fresnel
+
+from ..data.hologram import C0
+
+__all__ = [
+    "SpectralWindow",
+    "apparent_distance",
+    "attenuation",
+    "focal_shift",
+    "fresnel_coefficients",
+    "fresnel_number",
+    "lateral_resolution",
+    "longitudinal_resolution",
+    "max_unaliased_angle",
+    "refractive_index",
+    "spectral_window",
+    "wavelength",
+    "wavenumber",
+]
+
+
+def wavelength(frequency: float, eps: complex = 1.0) -> float:
+    """Wavelength ``c/(f*Re(n))``, metres. ``wavelength(9.9e9)`` is 3.03 cm."""
+    return C0 / (frequency * refractive_index(eps).real)
+
+
+def wavenumber(frequency: float) -> float:
+    """Wavenumber in air ``2*pi*f/c``, rad/m."""
+    return 2 * np.pi * frequency / C0
+
+
+def refractive_index(eps: complex) -> complex:
+    """``n = sqrt(eps)`` with ``Im(n) >= 0``."""
+    n = np.sqrt(complex(eps))
+    return -n if n.imag < 0 else n
+
+
+@dataclass(frozen=True)
+class SpectralWindow:
+    """The rectangle of object spatial frequencies a finite aperture records.
+
+    Attributes
+    ----------
+    mu, nu : float
+        Half-widths ``k*a/L``, ``k*b/L`` (rad/m).
+    p0, q0 : float
+        Transverse wavenumbers of the illumination, ``k*sin(alpha0)``, ``k*sin(beta0)``.
+
+    Notes
+    -----
+    In the frame of the reflected field ``f*E0`` (the hologram's own frame) the
+    window is ``|p| <= mu, |q| <= nu``. Since ``E0 = exp(i*(p0*x + q0*y))``
+    shifts the object's spectrum to ``F(p - p0, q - q0)``, the object's own
+    spectrum (incident phase removed) is seen over ``|p + p0| <= mu``,
+    ``|q + q0| <= nu``: the window centred at :attr:`center` = ``(-p0, -q0)``
+    (PHYSICS.md section 5, with ``F = ∫ f exp(-i(px + qy))``).
+    """
+
+    mu: float
+    nu: float
+    p0: float = 0.0
+    q0: float = 0.0
+
+    @property
+    def center(self) -> tuple[float, float]:
+        """Centre in the object-spectrum frame, ``(-p0, -q0)``."""
+        return -self.p0, -self.q0
+
+    @property
+    def p_range(self) -> tuple[float, float]:
+        """``(-mu - p0, mu - p0)``: the object frequencies seen along p."""
+        return -self.mu - self.p0, self.mu - self.p0
+
+    @property
+    def q_range(self) -> tuple[float, float]:
+        """``(-nu - q0, nu - q0)``."""
+        return -self.nu - self.q0, self.nu - self.q0
+
+    def contains(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """True where the object frequency (p, q) is recorded."""
+        return (np.abs(np.asarray(p) + self.p0) <= self.mu) & (
+            np.abs(np.asarray(q) + self.q0) <= self.nu)
+
+
+def spectral_window(frequency: float, aperture: float, distance: float, *,
+                    aperture_y: float | None = None, alpha0: float = 0.0,
+                    beta0: float = 0.0) -> SpectralWindow:
+    """Spectral window of an aperture of full widths (A, B) focused at ``distance``.
+
+    ``mu = k*A/(2*L)``, ``nu = k*B/(2*L)`` (PHYSICS.md section 4); pass the
+    apparent distance for a buried object.
+
+    Examples
+    --------
+    >>> w = spectral_window(9.9e9, 0.40, 0.60)
+    >>> round(np.pi / w.mu, 4)    # = lateral resolution lambda*L/A
+    0.0454
+    """
+    k = wavenumber(frequency)
+    B = aperture if aperture_y is None else aperture_y
+    return SpectralWindow(k * aperture / (2 * distance), k * B / (2 * distance),
+                          k * np.sin(alpha0), k * np.sin(beta0))
+
+
+def lateral_resolution(wavelength: float, distance: float, aperture: float) -> float:
+    """``delta = lambda*L/A`` (first null of the sinc, PHYSICS.md section 4).
+
+    Examples
+    --------
+    >>> round(lateral_resolution(0.03, 0.60, 0.40), 4)   # the paper's check
+    0.045
+    """
+    return wavelength * distance / aperture
+
+
+def _fresnel_amplitude(w: np.ndarray | float) -> np.ndarray:
+    """|∫_{-a}^{a} exp(i*psi*x^2) dx| / (2a) as a function of w = a*sqrt(2*psi/pi)."""
+    w = np.asarray(w, float)
+    S, C = fresnel(w)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(w > 0, np.hypot(C, S) / np.where(w > 0, w, 1), 1.0)
+
+
+def longitudinal_resolution(wavelength: float, distance: float, aperture: float, *,
+                            aperture_y: float | None = None) -> float:
+    """Depth resolution of a monochromatic hologram: FWHM of the on-axis intensity, metres.
+
+    A defocus dz multiplies the aperture field by ``exp(i*psi*(x^2 + y^2))`` with
+    ``psi = k*dz/(2*L^2)`` (paraxial). For a rectangular aperture the on-axis
+    amplitude factorises into two Fresnel integrals, ``A(w) = |C(w) + i S(w)|/w``
+    with ``w = a*sqrt(2*psi/pi)``; the intensity ``(A(w_x) A(w_y))^2`` falls to half
+    at a defocus found here by root finding. For a square aperture the result is
+    ``FWHM = 4*w_h^2*lambda*(L/A)^2`` with ``A(w_h)^4 = 1/2``, ``w_h = 1.1145``, i.e.
+    ``4.97*lambda*(L/A)^2``: a half-width of ``2.48*lambda*(L/A)^2`` against the
+    quarter-wave estimate ``2*lambda*(L/A)^2`` of PHYSICS.md.
+
+    Examples
+    --------
+    >>> round(longitudinal_resolution(0.03, 0.60, 0.40), 3)
+    0.335
+    """
+    B = aperture if aperture_y is None else aperture_y
+    a, b = aperture / 2, B / 2
+
+    def half(dz: float) -> float:
+        psi = np.pi * dz / (wavelength * distance**2)  # k*dz/(2 L^2)
+        wx = a * np.sqrt(2 * psi / np.pi)
+        wy = b * np.sqrt(2 * psi / np.pi)
+        return float((_fresnel_amplitude(wx) * _fresnel_amplitude(wy)) ** 2 - 0.5)
+
+    hi = 8 * wavelength * (distance / min(a, b)) ** 2
+    return 2 * brentq(half, 1e-12 * hi, hi)
+
+
+def focal_shift(wavelength: float, distance: float, aperture: float, *,
+                aperture_y: float | None = None) -> float:
+    """Shift of the on-axis intensity peak of a migrated point image, metres (negative: nearer).
+
+    The back-propagation kernel carries a ``1/z`` amplitude, so the on-axis
+    amplitude is ``(1/z) * A(w_x(z)) * A(w_y(z))`` with the defocus
+    ``psi = (k/2)*(1/L - 1/z)``; its maximum lies slightly nearer than L when the
+    Fresnel number ``a^2/(lambda*L)`` is small (Li & Wolf's focal shift). For a
+    buried point, pass the apparent distance and multiply the result by Re(n).
+    """
+    B = aperture if aperture_y is None else aperture_y
+    a, b = aperture / 2, B / 2
+    k = 2 * np.pi / wavelength
+
+    def neg_amp(z: float) -> float:
+        psi = abs(0.5 * k * (1 / distance - 1 / z))
+        s = np.sqrt(2 * psi / np.pi)
+        return -float(_fresnel_amplitude(a * s) * _fresnel_amplitude(b * s) / z)
+
+    span = longitudinal_resolution(wavelength, distance, aperture, aperture_y=aperture_y)
+    res = minimize_scalar(neg_amp, bounds=(max(distance - span, distance / 4), distance + 1e-9),
+                          method="bounded", options={"xatol": 1e-7})
+    return float(res.x - distance)
+
+
+def fresnel_number(aperture: float, wavelength: float, distance: float) -> float:
+    """``N_F = a^2/(lambda*L)`` with the half-width a = A/2."""
+    return (aperture / 2) ** 2 / (wavelength * distance)
+
+
+def apparent_distance(distance: float, z_surface: float, eps: complex) -> float:
+    """``L = z0 + (l - z0)/Re(n)`` for an object at range l below a surface at z0."""
+    if distance <= z_surface:
+        return float(distance)
+    return float(z_surface + (distance - z_surface) / refractive_index(eps).real)
+
+
+def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> dict[str, complex]:
+    """Fresnel amplitude coefficients from medium 1 into medium 2.
+
+    Parameters
+    ----------
+    eps1, eps2 : complex
+        Relative permittivities (incidence from 1).
+    theta : float
+        Angle of incidence in medium 1, radians.
+
+    Returns
+    -------
+    dict
+        ``r_te, t_te, r_tm, t_tm``: TE (E parallel to the interface) and TM
+        (sign of the tangential magnetic field; t_tm for the electric field).
+        At normal incidence ``r_te = (n1 - n2)/(n1 + n2)``, ``t = 2 n1/(n1 + n2)``:
+        from air into ground V = (1 - n)/(1 + n), W = 2/(1 + n).
+
+    Examples
+    --------
+    >>> c = fresnel_coefficients(1.0, 9.0)
+    >>> complex(c["r_te"]), complex(c["t_te"])
+    ((-0.5+0j), (0.5+0j))
+    """
+    n1, n2 = refractive_index(eps1), refractive_index(eps2)
+    kx = n1 * np.sin(theta)
+    c1 = np.sqrt(n1 * n1 - kx * kx + 0j)
+    c2 = np.sqrt(n2 * n2 - kx * kx + 0j)
+    c2 = -c2 if c2.imag < 0 else c2
+    return {
+        "r_te": (c1 - c2) / (c1 + c2),
+        "t_te": 2 * c1 / (c1 + c2),
+        "r_tm": (eps2 * c1 - eps1 * c2) / (eps2 * c1 + eps1 * c2),
+        "t_tm": 2 * n1 * n2 * c1 / (eps2 * c1 + eps1 * c2),
+    }
+
+
+def attenuation(eps: complex, frequency: float, distance: float) -> dict[str, float]:
+    """One-way amplitude decay ``exp(-k*Im(n)*d)`` over ``distance`` in a lossy medium.
+
+    Returns ``{"factor": ..., "dB": ..., "skin_depth": 1/(k*Im(n))}``.
+
+    Examples
+    --------
+    >>> round(float(attenuation(2.5 + 0.0125j, 9.9e9, 0.24)["dB"]), 3)   # sand, 12 cm both ways
+    -1.71
+    """
+    n = refractive_index(eps)
+    k = wavenumber(frequency)
+    factor = float(np.exp(-k * n.imag * distance))
+    skin = float(np.inf if n.imag == 0 else 1 / (k * n.imag))
+    return {"factor": factor, "dB": float(20 * np.log10(factor)), "skin_depth": skin}
+
+
+def max_unaliased_angle(pitch: float, wavelength: float) -> float:
+    """Largest arrival angle ``arcsin(lambda/(2*s))`` sampled without aliasing, radians.
+
+    Examples
+    --------
+    >>> round(float(np.degrees(max_unaliased_angle(0.025, 0.0303))), 1)   # paper's array
+    37.3
+    """
+    return float(np.arcsin(min(1.0, wavelength / (2 * pitch))))

@@ -1,0 +1,1 @@
+"""Data types: holograms and images with physical coordinates."""

@@ -1,0 +1,1 @@
+"""Imaging: migration (wave-front inversion) and what builds on it."""
