@@ -1,0 +1,1 @@
+"""Scene model: targets, receiver apertures and the forward simulation."""

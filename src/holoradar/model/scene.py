@@ -1,0 +1,112 @@
+"""Scene (medium + source + targets) and the receiver aperture."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._validate import as_axis
+from ..physics.medium import Medium
+from ..physics.sources import PlaneWave
+from .targets import PlanarTarget, PointTarget
+
+__all__ = ["Aperture", "Scene"]
+
+
+@dataclass(frozen=True, eq=False)
+class Aperture:
+    """A receiver array on the plane z = 0 whose elements sit on a grid.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Element coordinates along x and y, metres, strictly increasing (a
+        non-uniform grid is allowed; migration needs a uniform one). For
+        elements at arbitrary positions pass an ``(N, 2)`` array of positions to
+        :func:`holoradar.simulate` instead of an Aperture.
+
+    Examples
+    --------
+    >>> Aperture.paper().x.size, round(Aperture.paper().size[0], 3)
+    (16, 0.4)
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", as_axis(self.x, "x"))
+        object.__setattr__(self, "y", as_axis(self.y, "y"))
+
+    @classmethod
+    def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
+             center: tuple[float, float] = (0.0, 0.0)) -> Aperture:
+        """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``."""
+        if int(n) < 1 or (ny is not None and int(ny) < 1):
+            raise ValueError(f"n and ny must be >= 1 elements, got n={n}, ny={ny}")
+        if not pitch > 0 or (pitch_y is not None and not pitch_y > 0):
+            raise ValueError(f"pitch must be > 0 m, got {pitch}, {pitch_y}")
+        ny = int(n if ny is None else ny)
+        py = pitch if pitch_y is None else pitch_y
+        x = (np.arange(int(n)) - (int(n) - 1) / 2) * pitch + center[0]
+        y = (np.arange(ny) - (ny - 1) / 2) * py + center[1]
+        return cls(x, y)
+
+    @classmethod
+    def paper(cls) -> Aperture:
+        """The paper's receiver array: 16 x 16 elements at 2.5 cm, 40 cm square."""
+        return cls.grid(16, 0.025)
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """Full widths (A, B) = n * pitch (mean pitch for a non-uniform grid), metres."""
+        def width(a: np.ndarray) -> float:
+            return float(a.size * (a[-1] - a[0]) / (a.size - 1)) if a.size > 1 else 0.0
+        return width(self.x), width(self.y)
+
+    @property
+    def points(self) -> np.ndarray:
+        """Element positions (N, 3), row-major over (y, x), z = 0."""
+        X, Y = np.meshgrid(self.x, self.y)
+        return np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What the radar looks at: a medium, an illuminating source and targets.
+
+    Parameters
+    ----------
+    medium : Medium
+        Layered ground (default free space).
+    source : PlaneWave, PointSource or GaussianBeam
+        Illumination (default: a normal plane wave).
+    targets : sequence of PointTarget or PlanarTarget
+        The scatterers.
+
+    Examples
+    --------
+    >>> s = Scene(Medium.half_space(0.3, 2.5), targets=[PointTarget((0, 0, 0.4))])
+    >>> len(s.targets)
+    1
+    """
+
+    medium: Medium = field(default_factory=Medium.free_space)
+    source: Any = field(default_factory=PlaneWave)
+    targets: Sequence[PointTarget | PlanarTarget] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.medium, Medium):
+            raise ValueError("medium must be a holoradar.Medium, got "
+                             f"{type(self.medium).__name__}")
+        if not (hasattr(self.source, "field") and hasattr(self.source, "reflected")):
+            raise ValueError("source must be a PlaneWave, PointSource or GaussianBeam")
+        tg = tuple(self.targets)
+        for i, t in enumerate(tg):
+            if not isinstance(t, PointTarget | PlanarTarget):
+                raise ValueError(f"targets[{i}] must be a PointTarget or PlanarTarget, got "
+                                 f"{type(t).__name__}")
+        object.__setattr__(self, "targets", tg)

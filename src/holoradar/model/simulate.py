@@ -1,0 +1,180 @@
+"""Forward simulation: the hologram a receiver array records from a scene.
+
+The recorded field is the sum of (each optional):
+
+* the field scattered by the targets, carried up through the stack with each
+  layer's own kz and each interface's Fresnel transmission (refraction,
+  transmission both ways, absorption);
+* the specular reflection of the source from the ground (the glare: the wave of
+  the mirror-image source, reflection coefficient of the whole stack);
+* the direct field of the source at the aperture;
+* circular complex Gaussian receiver noise at a given SNR.
+
+Point targets use the exact Sommerfeld integral (:mod:`..physics.green`). A
+planar target's reflected field ``f*E0`` is carried by its angular spectrum
+(non-paraxial), evaluated exactly at the receivers by a direct (non-uniform)
+Fourier sum. Rays that would land far (> 10 wavelengths) off every receiver are
+tapered off smoothly, and the spectral sampling is chosen so that the periodic
+copies of the object lie farther than any kept ray can travel (a band-limited
+angular spectrum in the spirit of Matsushima and Shimobaba's), so nothing wraps.
+Against a direct Rayleigh-Sommerfeld sum the field agrees to about 0.1%.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import check_frequency
+from ..data.hologram import C0, Hologram
+from ..physics.green import free_space_green, layered_green
+from ..physics.medium import Medium
+from ..physics.propagation import lateral_travel
+from .scene import Aperture, Scene
+from .targets import PlanarTarget, PointTarget
+
+__all__ = ["simulate"]
+
+_MARGIN_WAVELENGTHS = 10.0
+
+
+def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
+             include_targets: bool = True, include_surface: bool = True,
+             include_direct: bool = False, snr_db: float | None = None,
+             seed: int | None = None) -> Hologram | np.ndarray:
+    """Simulate the hologram of ``scene`` recorded by ``aperture`` at ``frequency``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Medium, source and targets.
+    aperture : Aperture or ndarray of shape (N, 2) or (N, 3)
+        Receiver grid, or arbitrary element positions (x, y[, z]) in metres.
+    frequency : float
+        Hz.
+    include_targets : bool
+        Add the field scattered by the targets (default True).
+    include_surface : bool
+        Add the specular reflection of the source from the ground (default True;
+        nothing in free space).
+    include_direct : bool
+        Add the source's own field at the aperture (default False: a horn beside
+        the array radiates away from it; a plane wave passes through it).
+    snr_db : float, optional
+        Add receiver noise: ``10*log10(mean |signal|^2 / noise variance)``.
+    seed : int, optional
+        Seed of the noise generator.
+
+    Returns
+    -------
+    Hologram
+        For an :class:`Aperture` (its ``source`` is the scene's), else a complex
+        array (N,) of element fields.
+
+    Examples
+    --------
+    >>> import holoradar as hr
+    >>> scene = hr.Scene(hr.Medium.half_space(0.3, 2.5 + 0.0125j),
+    ...                  hr.PlaneWave(), [hr.PointTarget((0.0, 0.0, 0.42))])
+    >>> h = hr.simulate(scene, hr.Aperture.paper(), 9.9e9, include_surface=False)
+    >>> h.shape
+    (16, 16)
+    """
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene must be a holoradar.Scene, got {type(scene).__name__}")
+    f = check_frequency(frequency)
+    k = 2 * np.pi * f / C0
+    if isinstance(aperture, Aperture):
+        pts = aperture.points
+    else:
+        pts = np.asarray(aperture, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3) or not np.all(np.isfinite(pts)):
+            raise ValueError("aperture must be an Aperture or finite element positions of shape "
+                             f"(N, 2) or (N, 3) in metres, got shape {pts.shape}")
+        if pts.shape[1] == 2:
+            pts = np.c_[pts, np.zeros(len(pts))]
+    medium, source = scene.medium, scene.source
+    if not medium.is_free_space and np.any(pts[:, 2] >= medium.z_interfaces[0]):
+        raise ValueError("aperture elements must lie above the ground surface")
+    total = np.zeros(len(pts), complex)
+    if include_targets:
+        for t in scene.targets:
+            if isinstance(t, PointTarget):
+                total += _point_target(k, medium, source, t, pts)
+            else:
+                total += _planar_target(k, medium, source, t, pts)
+    if include_surface and not medium.is_free_space:
+        total += source.reflected(k, medium, pts)
+    if include_direct:
+        total += source.field(k, medium, pts)
+    if snr_db is not None:
+        rng = np.random.default_rng(seed)
+        power = float(np.mean(np.abs(total) ** 2))
+        sigma = np.sqrt(power / 10 ** (snr_db / 10) / 2)
+        total = total + sigma * (rng.standard_normal(total.shape)
+                                 + 1j * rng.standard_normal(total.shape))
+    if isinstance(aperture, Aperture):
+        return Hologram(total.reshape(aperture.y.size, aperture.x.size), aperture.x, aperture.y,
+                        f, source=source)
+    return total
+
+
+def _point_target(k: float, medium: Medium, source: object, t: PointTarget,
+                  pts: np.ndarray) -> np.ndarray:
+    e0 = source.field(k, medium, t.position[None, :])[0]
+    if medium.is_free_space:
+        g = free_space_green(k, t.position, pts)
+    else:
+        g = layered_green(k, medium, t.position, pts)
+    return t.amplitude * e0 * g
+
+
+def _planar_target(k: float, medium: Medium, source: object, t: PlanarTarget,
+                   pts: np.ndarray) -> np.ndarray:
+    f = t.reflectivity
+    iy, ix = np.nonzero(f)
+    if iy.size == 0:
+        return np.zeros(len(pts), complex)
+    # Only the rows/columns that hold the object matter.
+    ys, xs = t.y[iy.min():iy.max() + 1], t.x[ix.min():ix.max() + 1]
+    fsub = f[iy.min():iy.max() + 1, ix.min():ix.max() + 1]
+    X, Y = np.meshgrid(xs, ys)
+    sel = fsub != 0
+    pix = np.stack([X[sel], Y[sel], np.full(int(sel.sum()), t.z)], axis=1)
+    s = np.zeros(fsub.shape, complex)
+    s[sel] = fsub[sel] * source.field(k, medium, pix)
+    d = t.pixel
+    # Lateral extent D that any useful ray must bridge, and a margin for diffraction.
+    lo = np.minimum([xs[0], ys[0]], pts[:, :2].min(axis=0))
+    hi = np.maximum([xs[-1], ys[-1]], pts[:, :2].max(axis=0))
+    D = float(np.hypot(*(hi - lo)))
+    reach = D + max(_MARGIN_WAVELENGTHS * 2 * np.pi / k, 0.5 * D)
+    # Components whose rays travel laterally beyond `reach` land off every receiver;
+    # they are tapered off smoothly between reach and 2*reach (a sharp cut would ring),
+    # and the spectral period is wide enough that no kept ray from a periodic copy of
+    # the object lands on a receiver.
+    period = 4 * reach + D
+    dp = 2 * np.pi / period
+    kmax = min(np.pi / d, k)  # the object pixels carry no more; air carries no more
+    m = int(np.ceil(kmax / dp))
+    p = np.arange(-m, m + 1) * dp
+    P, Q = np.meshgrid(p, p)
+    kap2 = P * P + Q * Q
+    U = medium.vertical_transfer(k, kap2, t.z, 0.0)
+    travel = np.sqrt(kap2) * lateral_travel(k, medium, kap2, t.z)
+    with np.errstate(invalid="ignore"):
+        u = np.clip((travel - reach) / reach, 0, 1)
+    taper = np.where(np.isfinite(travel) & (kap2 < k * k), 0.5 * (1 + np.cos(np.pi * u)), 0)
+    U = U * taper
+    # Continuous FT of the object's field: S(q, p) = sum s exp(-i(p x + q y)) d^2.
+    Ey = np.exp(-1j * np.outer(p, ys))
+    Ex = np.exp(-1j * np.outer(xs, p))
+    S = Ey @ s @ Ex * d * d
+    A = S * U * dp * dp / (4 * np.pi**2)
+    # Direct (non-uniform) inverse Fourier sum at the receivers.
+    out = np.empty(len(pts), complex)
+    for c0 in range(0, len(pts), 2048):
+        c = pts[c0:c0 + 2048]
+        ey = np.exp(1j * np.outer(c[:, 1], p))      # (N, nq)
+        ex = np.exp(1j * np.outer(c[:, 0], p))      # (N, np)
+        out[c0:c0 + 2048] = np.sum((ey @ A) * ex, axis=1)
+    return out
