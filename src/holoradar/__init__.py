@@ -1,0 +1,50 @@
+"""holoradar: holographic subsurface radar imaging and simulation.
+
+Conventions (docs/conventions.md): SI units, time dependence exp(-i*omega*t),
+z is the range from the aperture plane towards the scene, Im(eps) >= 0 for loss.
+
+Examples
+--------
+>>> import holoradar as hr
+>>> scene = hr.Scene(hr.Medium.half_space(0.30, 2.5 + 0.0125j), hr.PlaneWave(),
+...                  [hr.PointTarget((0.0, 0.0, 0.42))])
+>>> holo = hr.simulate(scene, hr.Aperture.grid(64, 0.015), 9.9e9, include_surface=False)
+>>> img = hr.migrate(holo, [0.40, 0.42, 0.44], medium=scene.medium)
+>>> round(img.peak()[2], 2)
+0.42
+"""
+
+from . import theory
+from ._validate import AliasingWarning
+from .data.hologram import C0, Hologram, Image
+from .imaging.migrate import migrate
+from .model.scene import Aperture, Scene
+from .model.simulate import simulate
+from .model.targets import PlanarTarget, PointTarget
+from .physics.medium import Medium, permittivity
+from .physics.propagation import AngularSpectrum, Fresnel
+from .physics.sources import GaussianBeam, PlaneWave, PointSource
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "C0",
+    "AliasingWarning",
+    "AngularSpectrum",
+    "Aperture",
+    "Fresnel",
+    "GaussianBeam",
+    "Hologram",
+    "Image",
+    "Medium",
+    "PlanarTarget",
+    "PlaneWave",
+    "PointSource",
+    "PointTarget",
+    "Scene",
+    "__version__",
+    "migrate",
+    "permittivity",
+    "simulate",
+    "theory",
+]

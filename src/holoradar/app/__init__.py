@@ -1,0 +1,1 @@
+"""Applications: command line, plots, demo."""

@@ -1,0 +1,123 @@
+"""Command line: ``holoradar demo``, ``holoradar image`` and ``holoradar theory``."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import click
+import numpy as np
+
+__all__ = ["main"]
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="holoradar")
+def main() -> None:
+    """holoradar: holographic subsurface radar imaging and simulation."""
+
+
+@main.command()
+@click.option("--out", default="demo_out", show_default=True,
+              type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--upsample", default=8, show_default=True, type=click.IntRange(1, 32),
+              help="Image pixels per element pitch.")
+def demo(out: Path, upsample: int) -> None:
+    """Simulate the paper's lab stand (letter R in sand) and image it."""
+    from .demo import run_demo
+
+    t0 = time.perf_counter()
+    s = run_demo(out, upsample=upsample)
+    th = s["theory"]
+    pk, pc = s["image_peak_m"]["with_surface_glare"], s["image_peak_m"]["targets_only"]
+    click.echo("holoradar demo: paper lab stand, 16 x 16 array, 9.9 GHz, letter R 12 cm deep "
+               "in sand (eps' 2.5, tan_delta 0.005)")
+    click.echo(f"  apparent distance L       {th['apparent_distance_m'] * 100:6.1f} cm "
+               f"(true range {s['object']['range_m'] * 100:.1f} cm)")
+    click.echo(f"  lateral resolution        {th['lateral_resolution_m'] * 100:6.1f} cm "
+               "(lambda*L/A)")
+    dz = th["longitudinal_resolution_m_in_ground"]
+    click.echo(f"  depth resolution (FWHM)   {dz * 100:6.1f} cm in the sand")
+    click.echo(f"  glare / object at array   {s['glare_to_object_ratio_db']:6.1f} dB")
+    click.echo(f"  image peak, targets only  x={pc[0] * 100:.1f} y={pc[1] * 100:.1f} "
+               f"z={pc[2] * 100:.1f} cm")
+    click.echo(f"  image peak, with glare    x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} "
+               f"z={pk[2] * 100:.1f} cm")
+    click.echo(f"  wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s")
+
+
+@main.command()
+@click.argument("hologram_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--z", "z", required=True, help="Range(s) in metres: 0.4 or 0.3:0.5:0.01.")
+@click.option("--eps", default=None, help="Ground permittivity, e.g. 2.5+0.0125j.")
+@click.option("--z-surface", type=float, default=None, help="Ground surface range (m).")
+@click.option("--method", type=click.Choice(["angular", "fresnel"]), default="angular",
+              show_default=True)
+@click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32))
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="Output .npz (image) ; a PNG of the brightest plane is written beside it.")
+def image(hologram_file: Path, z: str, eps: str | None, z_surface: float | None, method: str,
+          upsample: int, out: Path) -> None:
+    """Migrate a hologram stored as .npz (keys data, x, y, frequency) to range(s) Z."""
+    from ..data.hologram import Hologram
+    from ..imaging.migrate import migrate
+    from ..physics.medium import Medium
+    from . import plotting
+    from .atomic import write_atomic
+
+    try:
+        zs: float | np.ndarray
+        if ":" in z:
+            a, b, st = (float(v) for v in z.split(":"))
+            zs = np.arange(a, b + st / 2, st)
+        else:
+            zs = float(z)
+    except ValueError:
+        raise click.BadParameter("expected a range in metres or start:stop:step",
+                                 param_hint="--z") from None
+    if (eps is None) != (z_surface is None):
+        raise click.BadParameter("give both --eps and --z-surface, or neither",
+                                 param_hint="--eps/--z-surface")
+    try:
+        with np.load(hologram_file) as d:
+            holo = Hologram(d["data"], d["x"], d["y"], float(d["frequency"]))
+        medium = None if eps is None else Medium.half_space(z_surface, complex(eps))
+        img = migrate(holo, zs, medium=medium, method=method, upsample=upsample)
+    except (KeyError, ValueError) as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    import io
+
+    buf = io.BytesIO()
+    np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency)
+    from ..analysis.metrics import peak_position
+
+    pk = peak_position(img)
+    fig = plotting.plot_image([img.plane(pk[2])], [f"{hologram_file.name} ({method})"])
+    write_atomic(out, buf.getvalue())
+    write_atomic(out.with_suffix(".png"), plotting.to_png(fig))
+    click.echo(json.dumps({"peak_m": pk, "out": str(out)}))
+
+
+@main.command(name="theory")
+@click.option("--frequency", default=9.9e9, show_default=True, type=float, help="Hz")
+@click.option("--aperture", default=0.40, show_default=True, type=float, help="full width, m")
+@click.option("--distance", default=0.60, show_default=True, type=float, help="range, m")
+def theory_cmd(frequency: float, aperture: float, distance: float) -> None:
+    """Print resolution and sampling figures for an aperture and range."""
+    from ..analysis import theory as th
+
+    lam = th.wavelength(frequency)
+    click.echo(json.dumps({
+        "wavelength_m": lam,
+        "lateral_resolution_m": th.lateral_resolution(lam, distance, aperture),
+        "longitudinal_resolution_m": th.longitudinal_resolution(lam, distance, aperture),
+        "fresnel_number": th.fresnel_number(aperture, lam, distance),
+        "focal_shift_m": th.focal_shift(lam, distance, aperture),
+    }, indent=2))
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,152 @@
+"""``holoradar demo``: simulate the paper's lab stand and image it.
+
+Everything is computed first; files are written only when all succeeded, each
+atomically.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._validate import AliasingWarning
+from ..analysis import theory
+from ..analysis.metrics import peak_position
+from ..imaging.migrate import migrate
+from ..model.simulate import simulate
+from . import plotting
+from .atomic import write_atomic
+from .presets import lab_stand
+
+__all__ = ["run_demo"]
+
+
+def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[str, Any]:
+    """Simulate the lab stand, migrate it and (if ``out``) write figures and summary.json.
+
+    Parameters
+    ----------
+    out : path or None
+        Output folder (created if missing). ``None`` computes without writing.
+    upsample : int
+        Image pixels per element pitch.
+
+    Returns
+    -------
+    dict
+        The summary written to ``summary.json``.
+
+    Examples
+    --------
+    >>> s = run_demo(None, upsample=1)
+    >>> round(s["theory"]["apparent_distance_m"], 4)
+    0.3759
+    """
+    t0 = time.perf_counter()
+    stand = lab_stand()
+    scene, ap, f = stand.scene, stand.aperture, stand.frequency
+    medium = scene.medium
+    holo = simulate(scene, ap, f)
+    clean = simulate(scene, ap, f, include_surface=False)
+    glare = simulate(scene, ap, f, include_targets=False)
+    t_sim = time.perf_counter() - t0
+
+    z_obj = stand.z_object
+    L = medium.apparent_distance(z_obj)
+    A = ap.size[0]
+    lam = holo.wavelength
+    n = medium.n(1)
+    zs = np.round(np.arange(0.30, 0.62 + 1e-9, 0.005), 6)
+    t1 = time.perf_counter()
+    # The paper's 2.5 cm pitch exceeds lambda/2: said once in the report, not per call.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AliasingWarning)
+        sweep = migrate(holo, zs, medium=medium, upsample=upsample)
+        sweep_clean = migrate(clean, zs, medium=medium, upsample=upsample)
+        at_obj = migrate(holo, z_obj, medium=medium, upsample=upsample)
+        at_obj_clean = migrate(clean, z_obj, medium=medium, upsample=upsample)
+        no_medium = migrate(clean, L, upsample=upsample)
+    t_img = time.perf_counter() - t1
+    peak = peak_position(sweep)
+    peak_clean = peak_position(sweep_clean)
+
+    # Object spectrum (incident phase removed) and the window of this geometry.
+    tg = stand.target
+    spec = np.fft.fftshift(np.fft.fft2(tg.reflectivity, s=(512, 512)))
+    p = np.fft.fftshift(np.fft.fftfreq(512, tg.pixel)) * 2 * np.pi
+    src = scene.source
+    dirn = np.array([0.0, 0.0, z_obj]) - src.position
+    sin_a, sin_b = dirn[:2] / np.linalg.norm(dirn)
+    win = theory.spectral_window(f, A, L, alpha0=float(np.arcsin(sin_a)),
+                                 beta0=float(np.arcsin(sin_b)))
+    reach = 1.1 * max(np.pi / float(ap.x[1] - ap.x[0]), abs(win.p0) + win.mu,
+                      abs(win.q0) + win.nu)
+    keep = np.abs(p) <= reach
+    summary: dict[str, Any] = {
+        "scene": "paper lab stand: letter R (10 x 15 cm, metal, reflection -1) in sand",
+        "frequency_hz": f,
+        "wavelength_m": lam,
+        "array": {"nx": int(ap.x.size), "ny": int(ap.y.size), "pitch_m": float(ap.x[1] - ap.x[0]),
+                  "aperture_m": A},
+        "medium": {"z_surface_m": stand.z_surface, "eps": [medium.eps[1].real,
+                                                           medium.eps[1].imag]},
+        "object": {"range_m": z_obj, "depth_m": z_obj - stand.z_surface},
+        "source": {"type": "horn (point source, cos^2 pattern)",
+                   "position_m": src.position.tolist()},
+        "theory": {
+            "apparent_distance_m": L,
+            "lateral_resolution_m": theory.lateral_resolution(lam, L, A),
+            "longitudinal_resolution_m_in_ground": theory.longitudinal_resolution(lam, L, A)
+            * n.real,
+            "fresnel_number": theory.fresnel_number(A, lam, L),
+            "focal_shift_m_in_ground": theory.focal_shift(lam, L, A) * n.real,
+            "two_way_attenuation_db": theory.attenuation(medium.eps[1], f,
+                                                         2 * (z_obj - stand.z_surface))["dB"],
+            "max_unaliased_angle_deg": float(np.degrees(theory.max_unaliased_angle(
+                float(ap.x[1] - ap.x[0]), lam))),
+            "window_mu_nu_rad_per_m": [win.mu, win.nu],
+            "illumination_p0_q0_rad_per_m": [win.p0, win.q0],
+        },
+        "image_peak_m": {"with_surface_glare": list(peak), "targets_only": list(peak_clean)},
+        "glare_to_object_ratio_db": float(20 * np.log10(
+            np.linalg.norm(glare.data) / np.linalg.norm(clean.data))),
+        "run_time_s": {"simulate": t_sim, "migrate": t_img,
+                       "total": time.perf_counter() - t0},
+    }
+    X, Y = np.meshgrid(tg.x, tg.y)
+    outline = (tg.x, tg.y, tg.reflectivity.real != 0)
+    figs = {
+        "hologram.png": plotting.plot_hologram(holo, "Simulated hologram"),
+        "image_object_range.png": plotting.plot_image(
+            [at_obj, at_obj_clean, no_medium],
+            ["with surface glare (migrated through sand)", "targets only (through sand)",
+             f"targets only, free-space migration to L = {L * 100:.1f} cm"],
+            outline=outline, suptitle="Image at the object (white: true letter R)"),
+        "depth_sweep.png": plotting.plot_depth_sweep(
+            sweep_clean, y=0.0, marks={"true range": z_obj, "surface": stand.z_surface},
+            title="Depth sweep through the sand (targets only)"),
+        "depth_sweep_with_glare.png": plotting.plot_depth_sweep(
+            sweep, y=0.0, marks={"true range": z_obj, "surface": stand.z_surface,
+                                 "mirror source 2*z0 - z_s": 2 * stand.z_surface
+                                 - src.position[2]},
+            title="Depth sweep through the sand (with surface glare)"),
+        "spectrum_window.png": plotting.plot_spectrum(
+            p[keep], p[keep], spec[np.ix_(keep, keep)], [win],
+            nyquist=np.pi / float(ap.x[1] - ap.x[0]),
+            title="Letter R spectrum |F(p, q)| and the window of the 16 x 16 array"),
+    }
+    del X, Y
+    pngs = {name: plotting.to_png(fig) for name, fig in figs.items()}
+    if out is not None:
+        outdir = Path(out)
+        outdir.mkdir(parents=True, exist_ok=True)
+        for name, payload in pngs.items():
+            write_atomic(outdir / name, payload)
+        summary["files"] = sorted([*pngs, "summary.json"])
+        write_atomic(outdir / "summary.json", json.dumps(summary, indent=2).encode())
+    return summary

@@ -1,0 +1,139 @@
+"""Figures with labelled axes and units; rendered off-screen to PNG bytes.
+
+Every function returns a :class:`matplotlib.figure.Figure` built without pyplot
+(no global state, no display needed); :func:`to_png` renders it.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+
+from ..analysis.theory import SpectralWindow
+from ..data.hologram import Hologram, Image
+
+__all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_spectrum", "to_png"]
+
+CM = 100.0
+
+
+def to_png(fig: Figure, dpi: int = 110) -> bytes:
+    """Render a figure to PNG bytes."""
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return buf.getvalue()
+
+
+def _edges(c: np.ndarray) -> np.ndarray:
+    c = np.asarray(c, float)
+    if c.size == 1:
+        return np.array([c[0] - 0.5, c[0] + 0.5])
+    mid = 0.5 * (c[1:] + c[:-1])
+    return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
+
+
+def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:
+    """Amplitude and phase of a hologram (x, y in cm)."""
+    fig = Figure(figsize=(10, 4.3), layout="constrained")
+    data = h.data.reshape((-1, *h.data.shape[-2:]))[0]
+    for ax, val, lab, cmap in zip(fig.subplots(1, 2),
+                                  (np.abs(data), np.angle(data)),
+                                  ("|E| (arb. units)", "phase (rad)"),
+                                  ("viridis", "twilight"), strict=True):
+        m = ax.pcolormesh(_edges(h.x) * CM, _edges(h.y) * CM, val, cmap=cmap, shading="flat")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (cm)")
+        ax.set_ylabel("y (cm)")
+        ax.set_title(f"{title}: {'amplitude' if 'E' in lab else 'phase'}")
+        fig.colorbar(m, ax=ax, label=lab)
+    fig.suptitle(f"{h.data.shape[-1]} x {h.data.shape[-2]} elements, "
+                 f"f = {h.frequency / 1e9:.3g} GHz")
+    return fig
+
+
+def plot_image(images: Sequence[Image], titles: Sequence[str], *,
+               outline: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+               suptitle: str = "") -> Figure:
+    """|image| of one plane per panel, normalised to each panel's maximum.
+
+    ``outline = (x, y, mask)`` draws the true object's contour in white.
+    """
+    fig = Figure(figsize=(5 * len(images), 4.5), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(images)))
+    for ax, img, title in zip(axes, images, titles, strict=True):
+        a = np.abs(img.data.reshape((-1, *img.data.shape[-2:]))[0])
+        a = a / a.max() if a.max() > 0 else a
+        m = ax.pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, a, cmap="inferno",
+                          vmin=0, vmax=1, shading="flat")
+        if outline is not None:
+            ox, oy, mask = outline
+            ax.contour(ox * CM, oy * CM, mask.astype(float), levels=[0.5], colors="w",
+                       linewidths=1.0)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (cm)")
+        ax.set_ylabel("y (cm)")
+        ax.set_title(f"{title}\nz = {img.z[0] * CM:.1f} cm")
+        fig.colorbar(m, ax=ax, label="|E| / max")
+    if suptitle:
+        fig.suptitle(suptitle)
+    return fig
+
+
+def plot_depth_sweep(img: Image, *, y: float = 0.0, marks: dict[str, float] | None = None,
+                     title: str = "Depth sweep") -> Figure:
+    """An x-z slice of |image| at ``y`` and the peak |image| of each plane against z."""
+    iy = int(np.argmin(np.abs(img.y - y)))
+    a = np.abs(img.data[..., iy, :])
+    a = a.reshape((-1, *a.shape[-2:]))[0]
+    fig = Figure(figsize=(11, 4.5), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2)
+    m = ax1.pcolormesh(_edges(img.x) * CM, _edges(img.z) * CM, a / a.max(), cmap="inferno",
+                       shading="flat")
+    ax1.invert_yaxis()
+    ax1.set_xlabel("x (cm)")
+    ax1.set_ylabel("range z from aperture (cm)")
+    ax1.set_title(f"|image| in the plane y = {img.y[iy] * CM:.1f} cm")
+    fig.colorbar(m, ax=ax1, label="|E| / max")
+    peak = np.abs(img.data).reshape((-1, img.z.size, img.y.size * img.x.size)).max(axis=(0, 2))
+    ax2.plot(img.z * CM, peak / peak.max(), "k-")
+    for (label, zv), style in zip((marks or {}).items(), ("--", ":", "-."), strict=False):
+        ax2.axvline(zv * CM, ls=style, color="C3" if style == "--" else "C0", label=label)
+        ax1.axhline(zv * CM, ls=style, color="w", lw=0.8)
+    ax2.set_xlabel("range z from aperture (cm)")
+    ax2.set_ylabel("max |E| in plane / max")
+    ax2.set_title("Focus against range")
+    if marks:
+        ax2.legend()
+    fig.suptitle(title)
+    return fig
+
+
+def plot_spectrum(p: np.ndarray, q: np.ndarray, spectrum: np.ndarray,
+                  windows: Sequence[SpectralWindow], *, nyquist: float | None = None,
+                  title: str = "Object spectrum and spectral window") -> Figure:
+    """|F(p, q)| (dB) with each view's spectral window drawn as a rectangle (rad/m)."""
+    fig = Figure(figsize=(6.2, 5.2), layout="constrained")
+    ax = fig.subplots()
+    s = np.abs(spectrum)
+    db = 20 * np.log10(np.maximum(s / s.max(), 1e-4))
+    m = ax.pcolormesh(_edges(p), _edges(q), db, cmap="magma", vmin=-40, vmax=0, shading="flat")
+    for i, w in enumerate(windows):
+        (p1, p2), (q1, q2) = w.p_range, w.q_range
+        ax.add_patch(Rectangle((p1, q1), p2 - p1, q2 - q1, fill=False, ec="c", lw=1.8,
+                               label="spectral window" if i == 0 else None))
+    if nyquist is not None:
+        ax.add_patch(Rectangle((-nyquist, -nyquist), 2 * nyquist, 2 * nyquist, fill=False,
+                               ec="w", ls="--", lw=1, label=r"sampling limit $\pm\pi/s$"))
+    ax.set_xlabel("p (rad/m)")
+    ax.set_ylabel("q (rad/m)")
+    ax.set_aspect("equal")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title(title)
+    fig.colorbar(m, ax=ax, label="|F(p, q)| (dB re max)")
+    return fig
