@@ -1,0 +1,106 @@
+"""Medium: Fresnel coefficients, stack transfer and reflection against closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from conftest import F0
+from holoradar import theory
+
+K = 2 * np.pi * F0 / hr.C0
+
+
+@pytest.mark.parametrize("eps", [2.5, 9.0, 4.0 + 0.3j])
+def test_normal_incidence_coefficients(eps):
+    # PHYSICS.md section 6: V = (1 - n)/(1 + n), W = 2/(1 + n), back out 2n/(1 + n).
+    n = np.sqrt(complex(eps))
+    m = hr.Medium.half_space(0.3, eps)
+    zero = np.array(0.0)
+    np.testing.assert_allclose(m.reflection(K, zero), (1 - n) / (1 + n), rtol=1e-13)
+    # Just above to just below the surface (a point on the interface belongs below).
+    down = m.vertical_transfer(K, zero, 0.3 - 1e-9, 0.3 + 1e-9)
+    up = m.vertical_transfer(K, zero, 0.3 + 1e-9, 0.3 - 1e-9)
+    np.testing.assert_allclose(down, 2 / (1 + n), rtol=1e-6)
+    np.testing.assert_allclose(up, 2 * n / (1 + n), rtol=1e-6)
+
+
+@pytest.mark.parametrize("theta_deg", [0, 20, 45, 70])
+@pytest.mark.parametrize("pol", ["TE", "TM"])
+def test_oblique_energy_conservation(theta_deg, pol):
+    # Lossless interface: |r|^2 + (Re(kz2)/kz1) |t|^2 = 1 for TE; for TM the transmitted
+    # power of the E amplitude carries eps1/eps2... written via the H amplitude t*n2/n1.
+    eps1, eps2 = 1.0, 6.0
+    c = theory.fresnel_coefficients(eps1, eps2, np.radians(theta_deg))
+    th = np.radians(theta_deg)
+    kz1 = np.cos(th)
+    kz2 = np.sqrt(eps2 - np.sin(th) ** 2)
+    if pol == "TE":
+        total = abs(c["r_te"]) ** 2 + kz2 / kz1 * abs(c["t_te"]) ** 2
+    else:
+        tH = c["t_tm"] * np.sqrt(eps2) / np.sqrt(eps1)
+        total = abs(c["r_tm"]) ** 2 + (kz2 / eps2) / (kz1 / eps1) * abs(tH) ** 2
+    assert abs(total - 1) < 1e-12
+
+
+def test_brewster_angle_tm():
+    eps2 = 4.0
+    th_b = np.arctan(np.sqrt(eps2))
+    c = theory.fresnel_coefficients(1.0, eps2, th_b)
+    assert abs(c["r_tm"]) < 1e-12
+    assert abs(c["r_te"]) > 0.3
+
+
+def test_medium_matches_theory_coefficients():
+    m = hr.Medium.half_space(0.3, 5.0, polarization="TM")
+    th = np.radians(35)
+    kap2 = np.array((K * np.sin(th)) ** 2)
+    c = theory.fresnel_coefficients(1.0, 5.0, th)
+    np.testing.assert_allclose(m.reflection(K, kap2), c["r_tm"], rtol=1e-12)
+    m = hr.Medium.half_space(0.3, 5.0)
+    np.testing.assert_allclose(m.reflection(K, kap2), c["r_te"], rtol=1e-12)
+
+
+def test_layer_reflection_quarter_wave_antireflection():
+    # A lambda/4 layer of index sqrt(n2) on a substrate n2 cancels normal reflection.
+    n2 = 4.0
+    n1 = np.sqrt(n2)
+    h = 2 * np.pi / K / (4 * n1)
+    m = hr.Medium.layered([0.3, 0.3 + h], [n1**2, n2**2])
+    assert abs(m.reflection(K, np.array(0.0))) < 1e-12
+
+
+def test_layer_of_same_medium_is_invisible():
+    a = hr.Medium.layered([0.3, 0.35], [2.5, 2.5])
+    b = hr.Medium.half_space(0.3, 2.5)
+    kap2 = np.linspace(0, 1.2, 7) ** 2 * K**2
+    np.testing.assert_allclose(a.reflection(K, kap2), b.reflection(K, kap2), atol=1e-13)
+    np.testing.assert_allclose(a.vertical_transfer(K, kap2, 0.4, 0.0),
+                               b.vertical_transfer(K, kap2, 0.4, 0.0), atol=1e-13)
+
+
+def test_attenuation_in_lossy_layer():
+    # Amplitude decays as exp(-k Im(n) d) at normal incidence (PHYSICS.md section 6).
+    eps = 2.5 + 0.0125j
+    m = hr.Medium.half_space(0.3, eps)
+    d = 0.2
+    t = m.vertical_transfer(K, np.array(0.0), 0.3 + d, 0.3 - 1e-12)
+    n = np.sqrt(eps)
+    np.testing.assert_allclose(abs(t), abs(2 * n / (1 + n)) * np.exp(-K * n.imag * d),
+                               rtol=1e-9)
+    np.testing.assert_allclose(theory.attenuation(eps, F0, d)["factor"],
+                               np.exp(-K * n.imag * d), rtol=1e-12)
+
+
+def test_apparent_distance():
+    m = hr.Medium.half_space(0.30, 9.0)
+    assert m.apparent_distance(0.50) == pytest.approx(0.30 + 0.20 / 3)
+    assert theory.apparent_distance(0.50, 0.30, 9.0) == pytest.approx(0.30 + 0.20 / 3)
+    assert m.apparent_distance(0.2) == pytest.approx(0.2)
+
+
+def test_permittivity_from_conductivity():
+    # sigma = 0.0069 S/m at 9.9 GHz is the gprMax sand: Im(eps) = sigma/(omega eps0) = 0.0125.
+    e = hr.permittivity(2.5, sigma=0.0069, frequency=9.9e9)
+    assert e.imag == pytest.approx(0.01253, rel=1e-3)

@@ -1,0 +1,115 @@
+"""Bad input: a clear ValueError naming the argument; aliasing warns and goes on."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from conftest import F0
+
+X = np.arange(8) * 0.01
+
+
+def _h(**kw):
+    args = {"data": np.ones((8, 8), complex), "x": X, "y": X, "frequency": F0}
+    args.update(kw)
+    return hr.Hologram(args.pop("data"), args.pop("x"), args.pop("y"), args.pop("frequency"))
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_nonfinite_data(bad):
+    d = np.ones((8, 8), complex)
+    d[2, 3] = bad
+    with pytest.raises(ValueError, match="data must be finite"):
+        _h(data=d)
+
+
+def test_shape_coordinate_mismatch():
+    with pytest.raises(ValueError, match="x must have 8 values"):
+        _h(x=np.arange(7) * 0.01)
+    with pytest.raises(ValueError, match="y must have 8 values"):
+        _h(y=np.arange(9) * 0.01)
+    with pytest.raises(ValueError, match="data must have at least 2 dimensions"):
+        _h(data=np.ones(8))
+
+
+def test_non_increasing_axis():
+    with pytest.raises(ValueError, match="x must be strictly increasing"):
+        _h(x=X[::-1])
+
+
+def test_non_uniform_grid_refused_by_migrate():
+    x = np.array([0, 0.01, 0.02, 0.035, 0.04, 0.05, 0.06, 0.07])
+    h = _h(x=x)  # a non-uniform grid is a valid hologram...
+    with pytest.raises(ValueError, match="x must be uniformly spaced"):
+        hr.migrate(h, 0.3)  # ...but FFT migration needs a uniform one
+
+
+@pytest.mark.parametrize("z", [-0.1, [0.2, -0.01], np.nan])
+def test_negative_or_nonfinite_range(z):
+    with pytest.raises(ValueError, match="z must be"):
+        hr.migrate(_h(), z)
+
+
+@pytest.mark.parametrize("f", [0.0, -9.9e9, np.nan, "ghz"])
+def test_bad_frequency(f):
+    with pytest.raises(ValueError, match="frequency must be a positive"):
+        _h(frequency=f)
+    with pytest.raises(ValueError, match="frequency must be a positive"):
+        hr.simulate(hr.Scene(), hr.Aperture.grid(4, 0.01), f)
+
+
+def test_gain_medium_refused():
+    with pytest.raises(ValueError, match=r"Im\(eps\) >= 0"):
+        hr.Medium.half_space(0.3, 2.5 - 0.1j)
+    with pytest.raises(ValueError, match=r"Im\(eps\) >= 0"):
+        hr.Medium.layered([0.3, 0.4], [2.5, 4 - 1j])
+
+
+def test_bad_medium_geometry():
+    with pytest.raises(ValueError, match="z_interfaces must be finite ranges > 0"):
+        hr.Medium.half_space(-0.1, 2.5)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        hr.Medium.layered([0.4, 0.3], [2.5, 4.0])
+    with pytest.raises(ValueError, match="one value per interface"):
+        hr.Medium.layered([0.3], [2.5, 4.0])
+
+
+def test_bad_method_upsample_pad():
+    with pytest.raises(ValueError, match="method must be"):
+        hr.migrate(_h(), 0.3, method="kirchhoff")
+    with pytest.raises(ValueError, match="upsample must be an integer >= 1"):
+        hr.migrate(_h(), 0.3, upsample=0)
+    with pytest.raises(ValueError, match="pad must be"):
+        hr.migrate(_h(), 0.3, pad=0.5)
+    with pytest.raises(ValueError, match=r"hologram must be a holoradar\.Hologram"):
+        hr.migrate(np.ones((8, 8)), 0.3)
+    with pytest.raises(ValueError, match="z must be > 0 with method='fresnel'"):
+        hr.migrate(_h(), 0.0, method="fresnel")
+
+
+def test_bad_sources_and_targets():
+    with pytest.raises(ValueError, match="position must be three finite"):
+        hr.PointSource((0, 0))
+    with pytest.raises(ValueError, match="propagating wave"):
+        hr.PlaneWave(np.pi / 2, 0.1)
+    with pytest.raises(ValueError, match="waist must be a positive"):
+        hr.GaussianBeam(0.0)
+    with pytest.raises(ValueError, match="position z must be > 0"):
+        hr.PointTarget((0, 0, -0.1))
+    with pytest.raises(ValueError, match="targets\\[0\\] must be"):
+        hr.Scene(targets=["rock"])
+    scene = hr.Scene(hr.Medium.half_space(0.3, 2.5), hr.PointSource((0, 0, 0.35)))
+    with pytest.raises(ValueError, match="must lie above the ground surface"):
+        hr.simulate(scene, hr.Aperture.grid(4, 0.01), F0)
+    with pytest.raises(ValueError, match=r"shape \(N, 2\) or \(N, 3\)"):
+        hr.simulate(hr.Scene(), np.ones((4, 5)), F0)
+
+
+def test_coarse_pitch_warns_and_goes_on():
+    x = np.arange(16) * 0.025  # the paper's array: 2.5 cm > lambda/2 = 1.5 cm
+    h = hr.Hologram(np.ones((16, 16)), x, x, F0)
+    with pytest.warns(hr.AliasingWarning, match=r"exceeds lambda/2.*37\.\d degrees"):
+        img = hr.migrate(h, 0.4)
+    assert np.all(np.isfinite(img.data))
