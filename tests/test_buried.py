@@ -31,7 +31,9 @@ def _hologram(eps, n, pitch):
 def test_buried_point_focuses_at_true_range(eps):
     # 96 x 96 at lambda/2 (1.45 m): Fresnel number a^2/(lambda L) = 46 (eps 2.5) and 51
     # (eps 9); the paraxial focal shift, n * theory.focal_shift(L), is then 0.16 and
-    # 0.22 mm, well inside the bound lambda_medium/4 (4.8 and 2.5 mm).
+    # 0.22 mm, well inside the bound lambda_medium/4 (4.8 and 2.5 mm). (In eps 9 the
+    # critical angle, arcsin(1/3), caps the cone of rays that leave the ground, so the
+    # focus is longer than the aperture alone allows, but it stays centred.)
     n = np.sqrt(eps)
     medium, h = _hologram(eps, 96, LAM / 2)
     L = medium.apparent_distance(ZT)

@@ -43,8 +43,10 @@ def demo(out: Path, upsample: int) -> None:
     click.echo(f"  glare / object at array   {s['glare_to_object_ratio_db']:6.1f} dB")
     click.echo(f"  image peak, targets only  x={pc[0] * 100:.1f} y={pc[1] * 100:.1f} "
                f"z={pc[2] * 100:.1f} cm")
-    click.echo(f"  image peak, with glare    x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} "
-               f"z={pk[2] * 100:.1f} cm")
+    click.echo(f"  brightest, with glare     x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} "
+               f"z={pk[2] * 100:.1f} cm (the horn's mirror image in the surface)")
+    click.echo(f"  array pitch exceeds lambda/2: waves beyond "
+               f"{th['max_unaliased_angle_deg']:.0f} degrees off axis alias")
     click.echo(f"  wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s")
 
 

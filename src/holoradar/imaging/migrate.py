@@ -9,7 +9,10 @@ paraxial Eq. 3 (through a medium: at the apparent distance).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+from functools import cache
 from typing import Literal
 
 import numpy as np
@@ -24,6 +27,7 @@ from ..physics.propagation import AngularSpectrum, Fresnel
 __all__ = ["migrate"]
 
 _CHUNK = 8  # planes per batched inverse FFT
+_POOL_SIZE = os.cpu_count() or 1
 
 
 def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
@@ -103,22 +107,62 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     ny, nx = op.shape
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    out = np.empty((*H.shape[:-2], zs.size, oy, ox), dtype=work)
+    batch = H.shape[:-2]
+    My, Mx = H.shape[-2:]
+    # Without crop or interpolation the products are computed in the output array itself
+    # and transformed in place: one multiply and one inverse FFT per plane, no copies.
+    in_place = u == 1 and (My, Mx) == (ny, nx)
+    out = np.empty((*batch, zs.size, oy, ox), dtype=work)
     show = out.size > 2e8 if progress is None else progress
-    bar = tqdm(total=zs.size, desc="migrate", unit="plane", disable=not show)
-    for c0 in range(0, zs.size, _CHUNK):
-        Us = op.transfers[c0:c0 + _CHUNK]
-        prod = np.stack([H * U.conj() for U in Us], axis=-3)
+    bar = tqdm(total=zs.size, desc="migrate", unit="plane") if show else None
+    chunk = zs.size if in_place else _CHUNK
+    for c0 in range(0, zs.size, chunk):
+        Ucs = op.adjoint_transfers[c0:c0 + chunk]
+        prod = out[..., c0:c0 + len(Ucs), :, :] if in_place else np.empty(
+            (*batch, len(Ucs), My, Mx), dtype=work)
+        _multiply_planes(H, Ucs, prod)
         if u > 1:
             prod = _zero_pad_spectrum(prod, u)
-        planes = sfft.ifft2(prod, axes=(-2, -1), workers=-1, overwrite_x=True)
-        out[..., c0:c0 + len(Us), :, :] = planes[..., :oy, :ox] * (u * u)
-        bar.update(len(Us))
-    bar.close()
+        planes = sfft.ifft2(prod, axes=(-2, -1), workers=op.workers, overwrite_x=True)
+        if not (in_place and np.may_share_memory(planes, out)):
+            sl = planes[..., :oy, :ox]
+            out[..., c0:c0 + len(Ucs), :, :] = sl * (u * u) if u > 1 else sl
+        if bar is not None:
+            bar.update(len(Ucs))
+    if bar is not None:
+        bar.close()
     x = hologram.x[0] + np.arange(ox) * dx / u
     y = hologram.y[0] + np.arange(oy) * dy / u
     data = out[..., 0, :, :] if scalar else out
     return Image(data, x, y, zs, hologram.frequency, method, has_z_axis=not scalar)
+
+
+def _multiply_planes(H: np.ndarray, Ucs: list[np.ndarray], prod: np.ndarray) -> None:
+    """``prod[..., i, :, :] = H * Ucs[i]`` for every plane, on all cores.
+
+    NumPy's multiply is single-threaded but releases the GIL, so a thread per core
+    takes a share of the planes; on a volume this is most of the work besides FFTs.
+    """
+    rows = H.shape[-2]
+    # Tasks: (plane, row block); a single plane is split in row blocks across cores.
+    blocks = max(1, -(-_POOL_SIZE // len(Ucs))) if rows >= 64 else 1
+    edges = np.linspace(0, rows, blocks + 1).astype(int)
+    tasks = [(i, slice(edges[b], edges[b + 1])) for i in range(len(Ucs)) for b in range(blocks)]
+
+    def work(task: tuple[int, slice]) -> None:
+        i, r = task
+        np.multiply(H[..., r, :], Ucs[i][r, :], out=prod[..., i, r, :])
+
+    if len(tasks) < 2 or _POOL_SIZE < 2:
+        for t in tasks:
+            work(t)
+        return
+    list(_pool().map(work, tasks))
+
+
+@cache
+def _pool() -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=_POOL_SIZE, thread_name_prefix="holoradar")
 
 
 def _zero_pad_spectrum(S: np.ndarray, u: int) -> np.ndarray:

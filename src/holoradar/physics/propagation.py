@@ -69,6 +69,9 @@ def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndar
     return (2 * np.pi * sfft.fftfreq(nx, dx), 2 * np.pi * sfft.fftfreq(ny, dy))
 
 
+_FREE = Medium.free_space()
+
+
 def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
     """Lateral distance per unit transverse wavenumber, ``sum_j h_j / Re(kz_j)`` (m^2/rad).
 
@@ -92,7 +95,8 @@ def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np
 
 @lru_cache(maxsize=64)
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
-                      medium: Medium, band_limit: bool) -> np.ndarray:
+                      medium: Medium, band_limit: bool, dtype: np.dtype,
+                      conjugate: bool) -> np.ndarray:
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
     U = medium.vertical_transfer(k, kappa2, z, 0.0)
@@ -107,6 +111,7 @@ def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z:
             ok = ((np.abs(p[None, :]) * t <= nx * dx / 2)
                   & (np.abs(q[:, None]) * t <= ny * dy / 2))
         U = np.where(ok | (kappa2 > k * k), U, 0)
+    U = (U.conj() if conjugate else U).astype(dtype, copy=False)
     U.setflags(write=False)
     return U
 
@@ -121,32 +126,44 @@ class _PlaneOperator(ABC):
         self.shape = (int(shape[0]), int(shape[1]))
         self.dx, self.dy, self.k = float(dx), float(dy), float(k)
         self.z = np.atleast_1d(np.asarray(z, dtype=float))
-        self.medium = medium if medium is not None else Medium.free_space()
+        self.medium = medium if medium is not None else _FREE
         self.fft_shape = padded_shape(self.shape, pad, pitch=(self.dx, self.dy),
                                       wavelength=2 * np.pi / self.k,
                                       z_max=float(self.z.max(initial=0.0)))
         self.dtype = np.dtype(dtype)
         self.band_limit = bool(band_limit)
         self._transfers: list[np.ndarray] | None = None
+        self._adjoint: list[np.ndarray] | None = None
 
-    # The transfer function of each plane, cast once to the working dtype.
     @property
     def transfers(self) -> list[np.ndarray]:
+        """Forward transfer function of each plane on the FFT grid (working dtype)."""
         if self._transfers is None:
-            self._transfers = [self._transfer(float(z)).astype(self.dtype, copy=False)
-                               for z in self.z]
+            self._transfers = [self._transfer(float(z)) for z in self.z]
         return self._transfers
 
+    @property
+    def adjoint_transfers(self) -> list[np.ndarray]:
+        """Their complex conjugates (cached, so that migration does not conjugate)."""
+        if self._adjoint is None:
+            self._adjoint = [self._transfer(float(z), conjugate=True) for z in self.z]
+        return self._adjoint
+
     @abstractmethod
-    def _transfer(self, z: float) -> np.ndarray:
-        """Transfer function of the plane at range ``z`` on the FFT grid."""
+    def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
+        """(Conjugated) transfer function of the plane at range ``z``, working dtype."""
+
+    @property
+    def workers(self) -> int:
+        """FFT threads: all cores, except for small grids where threads cost more."""
+        return -1 if self.fft_shape[0] * self.fft_shape[1] >= 128 * 128 else 1
 
     def _fft(self, a: np.ndarray) -> np.ndarray:
-        return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=-1)
+        return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=self.workers)
 
     def _ifft_crop(self, A: np.ndarray) -> np.ndarray:
         ny, nx = self.shape
-        return sfft.ifft2(A, axes=(-2, -1), workers=-1)[..., :ny, :nx]
+        return sfft.ifft2(A, axes=(-2, -1), workers=self.workers)[..., :ny, :nx]
 
     def spectrum(self, data: np.ndarray) -> np.ndarray:
         """Padded 2-D FFT of ``data`` (..., ny, nx) in the working dtype."""
@@ -173,8 +190,8 @@ class _PlaneOperator(ABC):
         """Aperture field (..., ny, nx) -> back-propagated fields (..., nz, ny, nx)."""
         H = self.spectrum(hologram)
         out = np.empty((*H.shape[:-2], self.z.size, *self.shape), dtype=self.dtype)
-        for i, U in enumerate(self.transfers):
-            out[..., i, :, :] = self._ifft_crop(H * U.conj())
+        for i, Uc in enumerate(self.adjoint_transfers):
+            out[..., i, :, :] = self._ifft_crop(H * Uc)
         return out
 
 
@@ -211,9 +228,9 @@ class AngularSpectrum(_PlaneOperator):
     (1, 32, 32)
     """
 
-    def _transfer(self, z: float) -> np.ndarray:
+    def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
         return _angular_transfer(self.fft_shape, self.dx, self.dy, self.k, z, self.medium,
-                                 self.band_limit)
+                                 self.band_limit, self.dtype, conjugate)
 
 
 class Fresnel(_PlaneOperator):
@@ -227,7 +244,7 @@ class Fresnel(_PlaneOperator):
     Nyquist ``pi/dx`` (beyond, the sampled chirp would alias).
     """
 
-    def _transfer(self, z: float) -> np.ndarray:
+    def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
         if z <= 0:
             raise ValueError("the Fresnel kernel needs z > 0")
         My, Mx = self.fft_shape
@@ -245,4 +262,5 @@ class Fresnel(_PlaneOperator):
         # sampling limit of the impulse-response method).
         kern = np.where((np.abs(ox[None, :]) * self.k / L <= np.pi / self.dx)
                         & (np.abs(oy[:, None]) * self.k / L <= np.pi / self.dy), kern, 0)
-        return sfft.fft2(kern, workers=-1)
+        U = sfft.fft2(kern, workers=-1)
+        return (U.conj() if conjugate else U).astype(self.dtype, copy=False)
