@@ -25,16 +25,17 @@ def _to_range(z_up: float) -> float:
 
 # --------------------------------------------------------------------------- S2
 @pytest.mark.parametrize("inc", ["+00", "+20", "-20", "+40", "-40"])
-def test_smuthi_buried_sphere_found_at_its_specular_point(inc):
+def test_smuthi_buried_sphere_focuses_at_its_mirror_focus(inc):
     """SMUTHI T-matrix: metal sphere (a = 1.5 cm) 10 cm deep in sand, plane wave at inc.
 
-    Geometrical optics: the image of a metal sphere is its specular highlight, the point
-    whose normal bisects the directions to the source (refracted: sin(t) = sin(inc)/n)
-    and to the array (straight up): at angle t/2 from the top, towards the side the wave
-    comes from. Its position carries an O(a/(k_m a)^2) = 0.6 mm GO error (k_m a = 4.9).
-    Depth: the focus lies short of it by the finite-aperture focal shift n*focal_shift(L)
-    (Fresnel number 9.6: 3.4 mm); the quarter-wave focus tolerance lambda_m/4 = 4.8 mm.
-    Lateral: lambda_m/20 (1 mm) bounds the GO error.
+    Geometrical optics: a convex spherical mirror lit by a plane wave reflects it as if
+    from its virtual focus, on the axis through the centre parallel to the (refracted)
+    incident direction k_t, a/2 from the centre: r_F = centre - (a/2) k_t, with
+    sin(t) = sin(inc)/n. A monochromatic image focuses on that point (wideband ranging
+    would find the surface instead). GO's error here is O(a/(k_m a)^2) = 0.6 mm
+    (k_m a = 4.9): laterally the bound is lambda_m/20 = 1 mm. In range the focus lies
+    short of r_F by the finite-aperture focal shift n*focal_shift(L) (Fresnel number
+    9.6: 3.4 mm), within the quarter-wave focus tolerance lambda_m/4 = 4.8 mm.
     """
     meta = json.loads((DATA / f"S2_buried_sphere_metal_inc{inc}.json").read_text())
     with np.load(DATA / f"S2_buried_sphere_metal_inc{inc}.npz") as d:
@@ -50,30 +51,31 @@ def test_smuthi_buried_sphere_found_at_its_specular_point(inc):
     n = medium.n(1).real
     lam = hr.C0 / f
     lam_m = lam / n
-    th = np.radians(float(inc))
-    half = 0.5 * np.arcsin(np.sin(th) / n)
-    x_spec = centre[0] - a * np.sin(half)  # positive inc: wave from -x, highlight at -x
-    z_spec = zc - a * np.cos(half)
+    # Refracted incident direction (x, range): positive inc travels towards +x.
+    sin_t = np.sin(np.radians(float(inc))) / n
+    x_focus = centre[0] - 0.5 * a * sin_t
+    z_focus = zc - 0.5 * a * np.sqrt(1 - sin_t**2)
     A = h.x.size * (h.x[1] - h.x[0])
-    L = medium.apparent_distance(z_spec)
+    L = medium.apparent_distance(z_focus)
     shift = n * theory.focal_shift(lam, L, A)
     img = hr.migrate(h, np.linspace(0.32, 0.46, 141), medium=medium, upsample=2)
     x, y, z = peak_position(img)
-    assert abs(x - x_spec) < lam_m / 20
+    assert abs(x - x_focus) < lam_m / 20
     assert abs(y - centre[1]) < lam_m / 20
-    assert abs(z - (z_spec + shift)) < lam_m / 4
+    assert abs(z - (z_focus + shift)) < lam_m / 4
 
 
 def test_smuthi_sphere_without_medium_sits_near_apparent_distance():
-    # Free-space migration places the sphere near L = z0 + d/n (PHYSICS.md section 6),
-    # within a quarter of the depth response (paraxial: FWHM of theory).
+    # Free-space migration places the sphere's mirror focus (a/2 above its centre, see
+    # above) near its apparent distance L = z0 + d/n (PHYSICS.md section 6) plus the
+    # focal shift, within a quarter of the depth response (paraxial: FWHM of theory).
     with np.load(DATA / "S2_buried_sphere_metal_inc+00.npz") as d:
         f = float(d["f_hz"][0])
         eps = complex(d["sand_eps"][0])
         h = hr.Hologram(d["E_scat"][1], d["x_m"], d["y_m"], f)
     medium = hr.Medium.half_space(0.30, eps)
     lam = hr.C0 / f
-    L = medium.apparent_distance(0.385)
+    L = medium.apparent_distance(0.40 - 0.0075)
     fw = theory.longitudinal_resolution(lam, L, 0.64)
     img = hr.migrate(h, np.linspace(0.28, 0.45, 171), upsample=2)
     assert abs(peak_position(img)[2] - (L + theory.focal_shift(lam, L, 0.64))) < fw / 4

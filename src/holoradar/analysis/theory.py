@@ -32,18 +32,36 @@ __all__ = [
 
 
 def wavelength(frequency: float, eps: complex = 1.0) -> float:
-    """Wavelength ``c/(f*Re(n))``, metres. ``wavelength(9.9e9)`` is 3.03 cm."""
+    """Wavelength ``c/(f*Re(n))`` in a medium of permittivity ``eps``, metres.
+
+    Examples
+    --------
+    >>> round(wavelength(9.9e9), 5), round(wavelength(9.9e9, 9.0), 5)
+    (0.03028, 0.01009)
+    """
     return C0 / (frequency * refractive_index(eps).real)
 
 
 def wavenumber(frequency: float) -> float:
-    """Wavenumber in air ``2*pi*f/c``, rad/m."""
+    """Wavenumber in air ``2*pi*f/c``, rad/m.
+
+    Examples
+    --------
+    >>> round(wavenumber(9.9e9), 2)
+    207.49
+    """
     return 2 * np.pi * frequency / C0
 
 
 def refractive_index(eps: complex) -> complex:
-    """``n = sqrt(eps)`` with ``Im(n) >= 0``."""
-    n = np.sqrt(complex(eps))
+    """``n = sqrt(eps)`` with ``Im(n) >= 0``.
+
+    Examples
+    --------
+    >>> refractive_index(9.0)
+    (3+0j)
+    """
+    n = complex(np.sqrt(complex(eps)))
     return -n if n.imag < 0 else n
 
 
@@ -173,6 +191,11 @@ def focal_shift(wavelength: float, distance: float, aperture: float, *,
     ``psi = (k/2)*(1/L - 1/z)``; its maximum lies slightly nearer than L when the
     Fresnel number ``a^2/(lambda*L)`` is small (Li & Wolf's focal shift). For a
     buried point, pass the apparent distance and multiply the result by Re(n).
+
+    Examples
+    --------
+    >>> round(focal_shift(0.0303, 0.376, 0.40), 4)    # paper array, L in sand
+    -0.0159
     """
     B = aperture if aperture_y is None else aperture_y
     a, b = aperture / 2, B / 2
@@ -190,12 +213,24 @@ def focal_shift(wavelength: float, distance: float, aperture: float, *,
 
 
 def fresnel_number(aperture: float, wavelength: float, distance: float) -> float:
-    """``N_F = a^2/(lambda*L)`` with the half-width a = A/2."""
+    """``N_F = a^2/(lambda*L)`` with the half-width a = A/2.
+
+    Examples
+    --------
+    >>> round(fresnel_number(0.40, 0.0303, 0.376), 2)
+    3.51
+    """
     return (aperture / 2) ** 2 / (wavelength * distance)
 
 
 def apparent_distance(distance: float, z_surface: float, eps: complex) -> float:
-    """``L = z0 + (l - z0)/Re(n)`` for an object at range l below a surface at z0."""
+    """``L = z0 + (l - z0)/Re(n)`` for an object at range l below a surface at z0.
+
+    Examples
+    --------
+    >>> round(apparent_distance(0.50, 0.30, 9.0), 4)    # the paper's Fig. 12 geometry
+    0.3667
+    """
     if distance <= z_surface:
         return float(distance)
     return float(z_surface + (distance - z_surface) / refractive_index(eps).real)

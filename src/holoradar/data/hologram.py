@@ -98,7 +98,14 @@ class Hologram:
         return self.x.size * dx, self.y.size * dy
 
     def with_data(self, data: Any) -> Hologram:
-        """A copy with new ``data`` of the same trailing shape (coordinates kept)."""
+        """A copy with new ``data`` of the same trailing shape (coordinates kept).
+
+        Examples
+        --------
+        >>> x = np.arange(4) * 0.01
+        >>> Hologram(np.ones((4, 4)), x, x, 1e10).with_data(np.zeros((2, 4, 4))).shape
+        (2, 4, 4)
+        """
         return Hologram(data, self.x, self.y, self.frequency, source=self.source)
 
     def replace(self, **changes: Any) -> Hologram:
@@ -161,7 +168,15 @@ class Image:
         return float(self.x[ix]), float(self.y[iy]), float(self.z[iz])
 
     def plane(self, z: float) -> Image:
-        """The plane nearest to range ``z`` as a 2-D image."""
+        """The plane nearest to range ``z`` as a 2-D image.
+
+        Examples
+        --------
+        >>> img = Image(np.zeros((2, 3, 4)), np.arange(4.0), np.arange(3.0),
+        ...             np.array([0.1, 0.2]), 9.9e9)
+        >>> img.plane(0.19).data.shape, float(img.plane(0.19).z[0])
+        ((3, 4), 0.2)
+        """
         if not self.has_z_axis:
             return self
         i = int(np.argmin(np.abs(self.z - z)))

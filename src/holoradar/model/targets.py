@@ -95,6 +95,24 @@ class PlanarTarget:
         return float(self.x[1] - self.x[0])
 
     @classmethod
+    def from_mask(cls, mask: np.ndarray, x: np.ndarray, y: np.ndarray, z: float, *,
+                  reflection: complex = 1.0) -> PlanarTarget:
+        """A planar target that reflects with ``reflection`` where ``mask`` is True.
+
+        Examples
+        --------
+        >>> u = np.arange(-10, 11) * 0.005
+        >>> t = PlanarTarget.from_mask(np.abs(u)[None, :] < 0.03 + 0 * u[:, None], u, u, 0.4,
+        ...                            reflection=-1)
+        >>> int((t.reflectivity == -1).sum())
+        231
+        """
+        m = np.asarray(mask)
+        if m.dtype != bool:
+            raise ValueError(f"mask must be a boolean array, got dtype {m.dtype}")
+        return cls(m * complex(reflection), x, y, z)
+
+    @classmethod
     def from_shape(cls, shape: str | Callable[..., np.ndarray], z: float, *,
                    center: tuple[float, float] = (0.0, 0.0), reflection: complex = 1.0,
                    pixel: float = 0.002, extent: float | None = None,

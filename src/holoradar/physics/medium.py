@@ -197,7 +197,13 @@ class Medium:
         return -n if n.imag < 0 else n
 
     def region_of(self, z: float | np.ndarray) -> np.ndarray | int:
-        """Index of the region that contains range ``z`` (interfaces belong below)."""
+        """Index of the region that contains range ``z`` (interfaces belong below).
+
+        Examples
+        --------
+        >>> Medium.half_space(0.3, 2.5).region_of(np.array([0.1, 0.3, 0.5]))
+        array([0, 1, 1])
+        """
         idx = np.searchsorted(np.asarray(self.z_interfaces), z, side="right")
         return int(idx) if np.ndim(idx) == 0 else idx
 
@@ -206,7 +212,13 @@ class Medium:
         return 0.0 if region == 0 else self.z_interfaces[region - 1]
 
     def kz(self, k: float, kappa2: np.ndarray | float, region: int) -> np.ndarray:
-        """Vertical wavenumber ``sqrt(k^2*eps - kappa^2)`` in a region, ``Im >= 0`` (rad/m)."""
+        """Vertical wavenumber ``sqrt(k^2*eps - kappa^2)`` in a region, ``Im >= 0`` (rad/m).
+
+        Examples
+        --------
+        >>> Medium.free_space().kz(1.0, np.array([0.0, 4.0]), 0).round(4)   # evanescent: +i
+        array([1.+0.j    , 0.+1.7321j])
+        """
         kz = np.sqrt(k * k * complex(self.eps[region]) - np.asarray(kappa2, dtype=complex))
         return np.where(kz.imag < 0, -kz, kz)
 
@@ -287,6 +299,11 @@ class Medium:
 
         The recursion (Parratt) sums the multiple reflections inside the layers;
         the phase reference is the top interface. Free space gives 0.
+
+        Examples
+        --------
+        >>> complex(Medium.half_space(0.3, 9.0).reflection(200.0, np.array(0.0)))  # (1-n)/(1+n)
+        (-0.5+0j)
         """
         kappa2 = np.asarray(kappa2, dtype=float)
         nreg = self.n_regions

@@ -31,7 +31,8 @@ import scipy.fft as sfft
 
 from .medium import Medium
 
-__all__ = ["AngularSpectrum", "Fresnel", "lateral_travel", "padded_shape", "spectral_axes"]
+__all__ = ["AngularSpectrum", "Fresnel", "lateral_travel", "loss_exponent", "padded_shape",
+           "spectral_axes"]
 
 
 def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[float, float]
@@ -93,10 +94,34 @@ def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np
     return travel
 
 
+def loss_exponent(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
+    """``sum_j Im(kz_j) * h_j`` over the layers a component crosses from range ``z`` to 0.
+
+    Counted only for components that propagate (``kappa^2 < k^2 Re(eps_j)``) in every
+    layer crossed, 0 elsewhere: it is the absorption of a travelling wave, not the
+    decay of an evanescent one. ``exp(-loss_exponent)`` is its one-way amplitude loss.
+    """
+    kappa2 = np.asarray(kappa2, dtype=float)
+    total = np.zeros(np.shape(kappa2))
+    propagating = np.ones(np.shape(kappa2), dtype=bool)
+    j = medium.region_of(z)
+    for m in range(j + 1):
+        top = medium.top_of(m)
+        bottom = z if m == j else medium.z_interfaces[m]
+        if bottom <= top:
+            continue
+        propagating &= kappa2 < k * k * complex(medium.eps[m]).real
+        total += medium.kz(k, kappa2, m).imag * (bottom - top)
+    return np.where(propagating, total, 0.0)
+
+
+_MAX_LOSS_GAIN = 100.0  # at most 40 dB of absorption is undone by compensate_loss
+
+
 @lru_cache(maxsize=64)
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                       medium: Medium, band_limit: bool, dtype: np.dtype,
-                      conjugate: bool) -> np.ndarray:
+                      conjugate: bool, compensate_loss: bool = False) -> np.ndarray:
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
     U = medium.vertical_transfer(k, kappa2, z, 0.0)
@@ -111,6 +136,10 @@ def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z:
             ok = ((np.abs(p[None, :]) * t <= nx * dx / 2)
                   & (np.abs(q[:, None]) * t <= ny * dy / 2))
         U = np.where(ok | (kappa2 > k * k), U, 0)
+    if conjugate and compensate_loss:
+        # Undo the absorption of the back-propagation, keep its phase and transmissions:
+        # the adjoint's extra exp(-Im(kz) h) favours shallow planes in lossy ground.
+        U = U * np.minimum(np.exp(loss_exponent(k, medium, kappa2, z)), _MAX_LOSS_GAIN)
     U = (U.conj() if conjugate else U).astype(dtype, copy=False)
     U.setflags(write=False)
     return U
@@ -122,7 +151,7 @@ class _PlaneOperator(ABC):
     def __init__(self, shape: tuple[int, int], dx: float, dy: float, k: float,
                  z: float | Sequence[float], medium: Medium | None = None,
                  pad: bool | float = True, dtype: type = np.complex128, *,
-                 band_limit: bool = True) -> None:
+                 band_limit: bool = True, compensate_loss: bool = False) -> None:
         self.shape = (int(shape[0]), int(shape[1]))
         self.dx, self.dy, self.k = float(dx), float(dy), float(k)
         self.z = np.atleast_1d(np.asarray(z, dtype=float))
@@ -132,6 +161,7 @@ class _PlaneOperator(ABC):
                                       z_max=float(self.z.max(initial=0.0)))
         self.dtype = np.dtype(dtype)
         self.band_limit = bool(band_limit)
+        self.compensate_loss = bool(compensate_loss)
         self._transfers: list[np.ndarray] | None = None
         self._adjoint: list[np.ndarray] | None = None
 
@@ -219,6 +249,10 @@ class AngularSpectrum(_PlaneOperator):
         Drop the components whose lateral shift exceeds half the FFT grid
         (band-limited angular spectrum, default True): they would wrap around.
         Evanescent components are kept (they decay).
+    compensate_loss : bool
+        Adjoint only: undo the absorption ``exp(-Im(kz)*h)`` of each propagating
+        component in lossy layers (at most 40 dB), keeping phase and
+        transmissions. Default False: the exact adjoint.
 
     Examples
     --------
@@ -230,7 +264,7 @@ class AngularSpectrum(_PlaneOperator):
 
     def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
         return _angular_transfer(self.fft_shape, self.dx, self.dy, self.k, z, self.medium,
-                                 self.band_limit, self.dtype, conjugate)
+                                 self.band_limit, self.dtype, conjugate, self.compensate_loss)
 
 
 class Fresnel(_PlaneOperator):
@@ -254,6 +288,9 @@ class Fresnel(_PlaneOperator):
         oy = np.fft.fftfreq(My, 1.0 / My) * self.dy
         L = self.medium.apparent_distance(z)
         T0 = complex(self.medium.vertical_transfer(self.k, np.array(0.0), z, 0.0))
+        if conjugate and self.compensate_loss:
+            T0 *= min(float(np.exp(loss_exponent(self.k, self.medium, np.array(0.0), z))),
+                      _MAX_LOSS_GAIN)
         r2 = oy[:, None] ** 2 + ox[None, :] ** 2
         kern = (T0 * self.k / (2j * np.pi * L) * np.exp(1j * self.k * r2 / (2 * L))
                 * self.dx * self.dy)
