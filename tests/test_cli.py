@@ -33,6 +33,11 @@ def test_demo_writes_labelled_figures_and_summary(tmp_path):
     assert abs(x) <= 0.05 + 0.02 and abs(y) <= 0.075 + 0.02
     assert z <= s["object"]["range_m"] + 0.01
     assert "apparent distance" in res.output
+    # The glare focuses at the horn's mirror image, beside the array: found within a
+    # quarter of the resolution cell lambda*z_m/A (4.5 cm) of where geometry puts it.
+    found, expected = (np.array(s["glare"][k]) for k in ("mirror_image_found_m",
+                                                          "mirror_image_expected_m"))
+    assert np.hypot(*(found[:2] - expected[:2])) < lam * expected[2] / 0.40 / 4
     assert not list(out.glob(".*tmp"))
 
 

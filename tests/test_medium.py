@@ -12,11 +12,13 @@ from holoradar import theory
 K = 2 * np.pi * F0 / hr.C0
 
 
+@pytest.mark.parametrize("pol", ["TE", "TM"])
 @pytest.mark.parametrize("eps", [2.5, 9.0, 4.0 + 0.3j])
-def test_normal_incidence_coefficients(eps):
-    # PHYSICS.md section 6: V = (1 - n)/(1 + n), W = 2/(1 + n), back out 2n/(1 + n).
+def test_normal_incidence_coefficients(eps, pol):
+    # PHYSICS.md section 6: V = (1 - n)/(1 + n), W = 2/(1 + n), back out 2n/(1 + n), for
+    # either polarisation (the scalar field is the tangential electric field).
     n = np.sqrt(complex(eps))
-    m = hr.Medium.half_space(0.3, eps)
+    m = hr.Medium.half_space(0.3, eps, polarization=pol)
     zero = np.array(0.0)
     np.testing.assert_allclose(m.reflection(K, zero), (1 - n) / (1 + n), rtol=1e-13)
     # Just above to just below the surface (a point on the interface belongs below).
@@ -50,6 +52,23 @@ def test_brewster_angle_tm():
     c = theory.fresnel_coefficients(1.0, eps2, th_b)
     assert abs(c["r_tm"]) < 1e-12
     assert abs(c["r_te"]) > 0.3
+
+
+@pytest.mark.parametrize("theta_deg", [10, 35, 60])
+def test_coefficients_match_textbook_angle_forms(theta_deg):
+    # Born & Wolf, sec. 1.5, in terms of angles (Snell: n1 sin t1 = n2 sin t2):
+    # r_s = (n1 c1 - n2 c2)/(n1 c1 + n2 c2), t_s = 2 n1 c1/(n1 c1 + n2 c2),
+    # r_p = (n2 c1 - n1 c2)/(n2 c1 + n1 c2), t_p = 2 n1 c1/(n2 c1 + n1 c2);
+    # r_p is signed by the magnetic field: the tangential-E convention used here is -r_p.
+    n1, n2 = 1.0, 2.2
+    t1 = np.radians(theta_deg)
+    t2 = np.arcsin(n1 * np.sin(t1) / n2)
+    c1, c2 = np.cos(t1), np.cos(t2)
+    c = theory.fresnel_coefficients(n1**2, n2**2, t1)
+    assert c["r_te"] == pytest.approx((n1 * c1 - n2 * c2) / (n1 * c1 + n2 * c2), abs=1e-13)
+    assert c["t_te"] == pytest.approx(2 * n1 * c1 / (n1 * c1 + n2 * c2), abs=1e-13)
+    assert c["r_tm"] == pytest.approx(-(n2 * c1 - n1 * c2) / (n2 * c1 + n1 * c2), abs=1e-13)
+    assert c["t_tm"] == pytest.approx(2 * n1 * c1 / (n2 * c1 + n1 * c2), abs=1e-13)
 
 
 def test_medium_matches_theory_coefficients():

@@ -25,7 +25,7 @@ def _rayleigh_sommerfeld(target: hr.PlanarTarget, e0: np.ndarray, pts: np.ndarra
     dz = target.z - pts[:, 2]
     R = np.sqrt((pts[:, None, 0] - xs) ** 2 + (pts[:, None, 1] - ys) ** 2 + dz[:, None] ** 2)
     ker = (dz[:, None] / R) * (1 / R - 1j * K) * np.exp(1j * K * R) / R / (2 * np.pi)
-    return ker @ s * target.pixel**2
+    return ker @ s * (target.pitch[0] * target.pitch[1])
 
 
 def test_planar_target_matches_rayleigh_sommerfeld():
@@ -51,6 +51,18 @@ def test_planar_target_oblique_illumination_matches_rayleigh_sommerfeld():
     p0, q0 = src.wavenumbers(K)
     e0 = np.exp(1j * (p0 * X + q0 * Y + np.sqrt(K**2 - p0**2 - q0**2) * tg.z))
     ref = _rayleigh_sommerfeld(tg, e0, ap.points).reshape(10, 10)
+    assert np.linalg.norm(h.data - ref) / np.linalg.norm(ref) < 0.02
+
+
+def test_planar_target_with_rectangular_pixels():
+    # Pixels of 2 x 4 mm: the Kirchhoff field scales with the pixel AREA dx*dy.
+    x = np.arange(-12, 13) * 0.002
+    y = np.arange(-6, 7) * 0.004
+    X, Y = np.meshgrid(x, y)
+    tg = hr.PlanarTarget.from_mask(X**2 + Y**2 < 0.02**2, x, y, 0.3, reflection=-1)
+    ap = hr.Aperture.grid(8, 0.04)
+    h = hr.simulate(hr.Scene(source=hr.PlaneWave(), targets=[tg]), ap, F0)
+    ref = _rayleigh_sommerfeld(tg, np.exp(1j * K * tg.z), ap.points).reshape(8, 8)
     assert np.linalg.norm(h.data - ref) / np.linalg.norm(ref) < 0.02
 
 
@@ -88,6 +100,10 @@ def test_arbitrary_positions_match_grid():
     grid = hr.simulate(scene, ap, F0)
     pts = hr.simulate(scene, ap.points[:, :2], F0)
     np.testing.assert_allclose(pts, grid.data.ravel(), rtol=1e-12)
+    scattered = hr.Aperture.from_positions(ap.points[::3, :2])
+    assert not scattered.is_grid
+    np.testing.assert_allclose(hr.simulate(scene, scattered, F0), grid.data.ravel()[::3],
+                               rtol=1e-12)
 
 
 def test_noise_has_requested_snr():
@@ -116,6 +132,9 @@ def test_gaussian_beam_waist_and_rayleigh_range():
     zr = K * w0**2 / 2
     on_axis = beam.field(K, hr.Medium.free_space(), np.array([[0.0, 0.0, 0.1 + zr]]))
     assert abs(abs(on_axis[0]) - 1 / np.sqrt(2)) < 0.02
+    # Far off its axis (50 waists) the beam is nothing: no periodic ghost of the quadrature.
+    far = beam.field(K, hr.Medium.free_space(), np.array([[50 * w0, 0.0, 0.1]]))
+    assert abs(far[0]) < 1e-6
 
 
 def test_horn_pattern():

@@ -113,3 +113,52 @@ def test_coarse_pitch_warns_and_goes_on():
     with pytest.warns(hr.AliasingWarning, match=r"exceeds lambda/2.*37\.\d degrees"):
         img = hr.migrate(h, 0.4)
     assert np.all(np.isfinite(img.data))
+
+
+def test_theory_refuses_bad_arguments():
+    from holoradar import theory
+
+    with pytest.raises(ValueError, match="distance must be > 0"):
+        theory.lateral_resolution(0.03, -0.6, 0.4)
+    with pytest.raises(ValueError, match="distance must be > 0"):
+        theory.longitudinal_resolution(0.03, 0.0, 0.4)
+    with pytest.raises(ValueError, match=r"Im\(eps\) >= 0"):
+        theory.apparent_distance(0.5, 0.3, 9 - 1j)
+    with pytest.raises(ValueError, match="theta must be an angle"):
+        theory.fresnel_coefficients(1.0, 4.0, 2.0)
+    with pytest.raises(ValueError, match="frequency must be a positive"):
+        theory.wavelength(0.0)
+
+
+def test_more_bad_arguments_name_themselves():
+    with pytest.raises(ValueError, match="z_surface must be a range"):
+        hr.Medium.half_space(None, 2.5)
+    with pytest.raises(ValueError, match="n must be a whole number"):
+        hr.Aperture.grid(2.7, 0.01)
+    with pytest.raises(ValueError, match=r"dtype must be numpy\.complex64"):
+        hr.migrate(_h(), 0.3, dtype=float)
+    with pytest.raises(ValueError, match="snr_db must be a number"):
+        hr.simulate(hr.Scene(), hr.Aperture.grid(4, 0.01), F0, snr_db="ten")
+    with pytest.raises(ValueError, match="alpha must be finite"):
+        hr.PlaneWave(np.nan, 0.0)
+    with pytest.raises(ValueError, match="propagating beam"):
+        hr.GaussianBeam(0.05, alpha=1.4, beta=1.4)
+    with pytest.raises(ValueError, match="amplitude must be a finite complex"):
+        hr.PointSource((0, 0, 0), amplitude="loud")
+    with pytest.raises(ValueError, match="amplitude must be finite"):
+        hr.PointTarget((0, 0, 0.4), amplitude=np.nan)
+    with pytest.raises(ValueError, match="source must be a PlaneWave"):
+        hr.Hologram(np.ones((4, 4)), X[:4], X[:4], F0, source=42)
+    layered = hr.Medium.layered(0.3, [2.5])  # a scalar interface is one interface
+    assert layered.z_interfaces == (0.3,)
+
+
+def test_inputs_are_copied_not_shared():
+    x = np.arange(8) * 0.01
+    h = hr.Hologram(np.ones((8, 8)), x, x, F0)
+    x[0] = 5.0  # the caller may still write to their array ...
+    assert h.x[0] == 0.0  # ... and the hologram does not see it
+    pos = np.array([0.0, 0.0, 0.1])
+    src = hr.PointSource(pos)
+    pos[2] = 0.9
+    assert src.position[2] == 0.1

@@ -14,8 +14,10 @@ import numpy as np
 __all__ = [
     "AliasingWarning",
     "as_axis",
+    "as_complex_scalar",
     "as_finite_complex",
     "as_position",
+    "as_real",
     "check_frequency",
     "check_nonnegative_ranges",
     "uniform_step",
@@ -53,7 +55,10 @@ def as_finite_complex(data: object, name: str, *, min_ndim: int = 0) -> np.ndarr
 
 def as_axis(values: object, name: str, *, length: int | None = None) -> np.ndarray:
     """Return a strictly increasing, finite 1-D float axis (metres)."""
-    arr = np.asarray(values, dtype=float)
+    try:
+        arr = np.array(values, dtype=float)  # a copy: the caller's array stays theirs
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 1-D sequence of coordinates in metres") from None
     if arr.ndim != 1 or arr.size < 1:
         raise ValueError(f"{name} must be a 1-D sequence of coordinates in metres, got shape "
                          f"{arr.shape}")
@@ -97,11 +102,42 @@ def check_nonnegative_ranges(z: object, name: str = "z") -> np.ndarray:
 
 def as_position(position: Sequence[float] | np.ndarray, name: str = "position") -> np.ndarray:
     """Return an (x, y, z) position in metres as a float array of shape (3,)."""
-    arr = np.asarray(position, dtype=float)
+    try:
+        arr = np.array(position, dtype=float)  # a copy, read-only below
+    except (TypeError, ValueError):
+        arr = np.empty(0)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be three finite coordinates (x, y, z) in metres, got "
                          f"{position!r}")
+    arr.setflags(write=False)
     return arr
+
+
+def as_complex_scalar(value: object, name: str) -> complex:
+    """Return a finite complex number, or raise naming the argument."""
+    try:
+        c = complex(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite complex number, got {value!r}") from None
+    if not (np.isfinite(c.real) and np.isfinite(c.imag)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return c
+
+
+def as_real(value: object, name: str, *, positive: bool = False,
+            nonnegative: bool = False) -> float:
+    """Return a finite float (optionally > 0 or >= 0), or raise naming the argument."""
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    if positive and v <= 0:
+        raise ValueError(f"{name} must be > 0, got {value!r}")
+    if nonnegative and v < 0:
+        raise ValueError(f"{name} must be >= 0, got {value!r}")
+    return v
 
 
 def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture") -> None:

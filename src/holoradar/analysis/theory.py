@@ -12,7 +12,9 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 from scipy.special import fresnel
 
+from .._validate import as_real, check_frequency
 from ..data.hologram import C0
+from ..physics.medium import _check_eps
 
 __all__ = [
     "SpectralWindow",
@@ -31,6 +33,11 @@ __all__ = [
 ]
 
 
+def _positive(**kw: float) -> list[float]:
+    """Check that each named length or angle is a finite number > 0."""
+    return [as_real(v, k, positive=True) for k, v in kw.items()]
+
+
 def wavelength(frequency: float, eps: complex = 1.0) -> float:
     """Wavelength ``c/(f*Re(n))`` in a medium of permittivity ``eps``, metres.
 
@@ -39,7 +46,7 @@ def wavelength(frequency: float, eps: complex = 1.0) -> float:
     >>> round(wavelength(9.9e9), 5), round(wavelength(9.9e9, 9.0), 5)
     (0.03028, 0.01009)
     """
-    return C0 / (frequency * refractive_index(eps).real)
+    return C0 / (check_frequency(frequency) * refractive_index(eps).real)
 
 
 def wavenumber(frequency: float) -> float:
@@ -50,7 +57,7 @@ def wavenumber(frequency: float) -> float:
     >>> round(wavenumber(9.9e9), 2)
     207.49
     """
-    return 2 * np.pi * frequency / C0
+    return 2 * np.pi * check_frequency(frequency) / C0
 
 
 def refractive_index(eps: complex) -> complex:
@@ -61,7 +68,7 @@ def refractive_index(eps: complex) -> complex:
     >>> refractive_index(9.0)
     (3+0j)
     """
-    n = complex(np.sqrt(complex(eps)))
+    n = complex(np.sqrt(_check_eps(eps, "eps")))
     return -n if n.imag < 0 else n
 
 
@@ -128,6 +135,7 @@ def spectral_window(frequency: float, aperture: float, distance: float, *,
     """
     k = wavenumber(frequency)
     B = aperture if aperture_y is None else aperture_y
+    _positive(aperture=aperture, aperture_y=B, distance=distance)
     return SpectralWindow(k * aperture / (2 * distance), k * B / (2 * distance),
                           k * np.sin(alpha0), k * np.sin(beta0))
 
@@ -140,6 +148,7 @@ def lateral_resolution(wavelength: float, distance: float, aperture: float) -> f
     >>> round(lateral_resolution(0.03, 0.60, 0.40), 4)   # the paper's check
     0.045
     """
+    _positive(wavelength=wavelength, distance=distance, aperture=aperture)
     return wavelength * distance / aperture
 
 
@@ -170,6 +179,7 @@ def longitudinal_resolution(wavelength: float, distance: float, aperture: float,
     0.335
     """
     B = aperture if aperture_y is None else aperture_y
+    _positive(wavelength=wavelength, distance=distance, aperture=aperture, aperture_y=B)
     a, b = aperture / 2, B / 2
 
     def half(dz: float) -> float:
@@ -198,6 +208,7 @@ def focal_shift(wavelength: float, distance: float, aperture: float, *,
     -0.0159
     """
     B = aperture if aperture_y is None else aperture_y
+    _positive(wavelength=wavelength, distance=distance, aperture=aperture, aperture_y=B)
     a, b = aperture / 2, B / 2
     k = 2 * np.pi / wavelength
 
@@ -220,6 +231,7 @@ def fresnel_number(aperture: float, wavelength: float, distance: float) -> float
     >>> round(fresnel_number(0.40, 0.0303, 0.376), 2)
     3.51
     """
+    _positive(aperture=aperture, wavelength=wavelength, distance=distance)
     return (aperture / 2) ** 2 / (wavelength * distance)
 
 
@@ -231,6 +243,7 @@ def apparent_distance(distance: float, z_surface: float, eps: complex) -> float:
     >>> round(apparent_distance(0.50, 0.30, 9.0), 4)    # the paper's Fig. 12 geometry
     0.3667
     """
+    _positive(distance=distance, z_surface=z_surface)
     if distance <= z_surface:
         return float(distance)
     return float(z_surface + (distance - z_surface) / refractive_index(eps).real)
@@ -249,8 +262,9 @@ def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> di
     Returns
     -------
     dict
-        ``r_te, t_te, r_tm, t_tm``: TE (E parallel to the interface) and TM
-        (sign of the tangential magnetic field; t_tm for the electric field).
+        ``r_te, t_te, r_tm, t_tm``: TE (E parallel to the interface) and TM, both
+        signed as the tangential electric field (``r_tm`` is the negative of the
+        magnetic-field r_p; ``t_tm`` is the ratio of electric-field amplitudes).
         At normal incidence ``r_te = (n1 - n2)/(n1 + n2)``, ``t = 2 n1/(n1 + n2)``:
         from air into ground V = (1 - n)/(1 + n), W = 2/(1 + n).
 
@@ -261,6 +275,9 @@ def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> di
     ((-0.5+0j), (0.5+0j))
     """
     n1, n2 = refractive_index(eps1), refractive_index(eps2)
+    theta = as_real(theta, "theta")
+    if not 0 <= theta < np.pi / 2:
+        raise ValueError(f"theta must be an angle of incidence in [0, pi/2) radians, got {theta}")
     kx = n1 * np.sin(theta)
     c1 = np.sqrt(n1 * n1 - kx * kx + 0j)
     c2 = np.sqrt(n2 * n2 - kx * kx + 0j)
@@ -268,7 +285,7 @@ def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> di
     return {
         "r_te": (c1 - c2) / (c1 + c2),
         "t_te": 2 * c1 / (c1 + c2),
-        "r_tm": (eps2 * c1 - eps1 * c2) / (eps2 * c1 + eps1 * c2),
+        "r_tm": (eps1 * c2 - eps2 * c1) / (eps2 * c1 + eps1 * c2),
         "t_tm": 2 * n1 * n2 * c1 / (eps2 * c1 + eps1 * c2),
     }
 
@@ -285,6 +302,7 @@ def attenuation(eps: complex, frequency: float, distance: float) -> dict[str, fl
     """
     n = refractive_index(eps)
     k = wavenumber(frequency)
+    distance = as_real(distance, "distance", nonnegative=True)
     factor = float(np.exp(-k * n.imag * distance))
     skin = float(np.inf if n.imag == 0 else 1 / (k * n.imag))
     return {"factor": factor, "dB": float(20 * np.log10(factor)), "skin_depth": skin}
@@ -298,4 +316,5 @@ def max_unaliased_angle(pitch: float, wavelength: float) -> float:
     >>> round(float(np.degrees(max_unaliased_angle(0.025, 0.0303))), 1)   # paper's array
     37.3
     """
+    _positive(pitch=pitch, wavelength=wavelength)
     return float(np.arcsin(min(1.0, wavelength / (2 * pitch))))

@@ -31,7 +31,8 @@ def demo(out: Path, upsample: int) -> None:
     t0 = time.perf_counter()
     s = run_demo(out, upsample=upsample)
     th = s["theory"]
-    pk, pc = s["image_peak_m"]["with_surface_glare"], s["image_peak_m"]["targets_only"]
+    pc = s["image_peak_m"]["targets_only"]
+    mf, me = s["glare"]["mirror_image_found_m"], s["glare"]["mirror_image_expected_m"]
     click.echo("holoradar demo: paper lab stand, 16 x 16 array, 9.9 GHz, letter R 12 cm deep "
                "in sand (eps' 2.5, tan_delta 0.005)")
     click.echo(f"  apparent distance L       {th['apparent_distance_m'] * 100:6.1f} cm "
@@ -39,12 +40,13 @@ def demo(out: Path, upsample: int) -> None:
     click.echo(f"  lateral resolution        {th['lateral_resolution_m'] * 100:6.1f} cm "
                "(lambda*L/A)")
     dz = th["longitudinal_resolution_m_in_ground"]
-    click.echo(f"  depth resolution (FWHM)   {dz * 100:6.1f} cm in the sand")
+    click.echo(f"  depth resolution (FWHM)   {dz * 100:6.1f} cm in the sand: at one frequency "
+               "depth is barely resolved")
     click.echo(f"  glare / object at array   {s['glare_to_object_ratio_db']:6.1f} dB")
     click.echo(f"  image peak, targets only  x={pc[0] * 100:.1f} y={pc[1] * 100:.1f} "
                f"z={pc[2] * 100:.1f} cm")
-    click.echo(f"  brightest, with glare     x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} "
-               f"z={pk[2] * 100:.1f} cm (the horn's mirror image in the surface)")
+    click.echo(f"  glare: mirror image found x={mf[0] * 100:.1f} y={mf[1] * 100:.1f} cm at "
+               f"z={mf[2] * 100:.0f} cm (expected x={me[0] * 100:.1f} y={me[1] * 100:.1f})")
     click.echo(f"  array pitch exceeds lambda/2: waves beyond "
                f"{th['max_unaliased_angle_deg']:.0f} degrees off axis alias")
     click.echo(f"  wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s")

@@ -71,9 +71,14 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         at_obj = migrate(holo, z_obj, medium=medium, upsample=upsample)
         at_obj_clean = migrate(clean, z_obj, medium=medium, upsample=upsample)
         no_medium = migrate(clean, L, upsample=upsample)
+        # The glare is the wave of the horn's mirror image: it travels in air only, so
+        # it focuses under free-space migration at z_m = 2*z0 - z_s, beside the array.
+        z_m = 2 * stand.z_surface - scene.source.position[2]
+        mirror_plane = migrate(holo, z_m, upsample=upsample, fov="full")
     t_img = time.perf_counter() - t1
     peak = peak_position(sweep)
     peak_clean = peak_position(sweep_clean)
+    mirror_found = peak_position(mirror_plane)
 
     # Object spectrum (incident phase removed) and the window of this geometry.
     tg = stand.target
@@ -93,8 +98,8 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         "wavelength_m": lam,
         "array": {"nx": int(ap.x.size), "ny": int(ap.y.size), "pitch_m": float(ap.x[1] - ap.x[0]),
                   "aperture_m": A},
-        "medium": {"z_surface_m": stand.z_surface, "eps": [medium.eps[1].real,
-                                                           medium.eps[1].imag]},
+        "medium": {"z_surface_m": stand.z_surface, "eps_real": medium.eps[1].real,
+                   "eps_imag": medium.eps[1].imag},
         "object": {"range_m": z_obj, "depth_m": z_obj - stand.z_surface},
         "source": {"type": "horn (point source, cos^2 pattern)",
                    "position_m": src.position.tolist()},
@@ -112,13 +117,15 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
             "window_mu_nu_rad_per_m": [win.mu, win.nu],
             "illumination_p0_q0_rad_per_m": [win.p0, win.q0],
         },
-        "image_peak_m": {"with_surface_glare": list(peak), "targets_only": list(peak_clean)},
+        "image_peak_m": {"with_surface_glare_through_sand": list(peak),
+                         "targets_only": list(peak_clean)},
+        "glare": {"mirror_image_expected_m": scene.source.mirror_position(medium).tolist(),
+                  "mirror_image_found_m": list(mirror_found)},
         "glare_to_object_ratio_db": float(20 * np.log10(
             np.linalg.norm(glare.data) / np.linalg.norm(clean.data))),
         "run_time_s": {"simulate": t_sim, "migrate": t_img,
                        "total": time.perf_counter() - t0},
     }
-    X, Y = np.meshgrid(tg.x, tg.y)
     outline = (tg.x, tg.y, tg.reflectivity.real != 0)
     figs = {
         "hologram.png": plotting.plot_hologram(holo, "Simulated hologram"),
@@ -130,17 +137,17 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         "depth_sweep.png": plotting.plot_depth_sweep(
             sweep_clean, y=0.0, marks={"true range": z_obj, "surface": stand.z_surface},
             title="Depth sweep through the sand (targets only)"),
-        "depth_sweep_with_glare.png": plotting.plot_depth_sweep(
-            sweep, y=0.0, marks={"true range": z_obj, "surface": stand.z_surface,
-                                 "mirror source 2*z0 - z_s": 2 * stand.z_surface
-                                 - src.position[2]},
-            title="Depth sweep through the sand (with surface glare)"),
+        "glare_mirror_plane.png": plotting.plot_image(
+            [mirror_plane], ["free-space migration of the full hologram"],
+            marks={"horn's mirror image": scene.source.mirror_position(medium)[:2],
+                   "array": None}, aperture=(ap.x, ap.y),
+            suptitle=f"Surface glare: the horn's mirror image\nfocuses at z_m = 2 z0 - z_s = "
+                     f"{z_m * 100:.0f} cm, beside the array"),
         "spectrum_window.png": plotting.plot_spectrum(
             p[keep], p[keep], spec[np.ix_(keep, keep)], [win],
             nyquist=np.pi / float(ap.x[1] - ap.x[0]),
             title="Letter R spectrum |F(p, q)| and the window of the 16 x 16 array"),
     }
-    del X, Y
     pngs = {name: plotting.to_png(fig) for name, fig in figs.items()}
     if out is not None:
         outdir = Path(out)

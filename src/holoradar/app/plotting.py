@@ -44,7 +44,7 @@ def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:
     data = h.data.reshape((-1, *h.data.shape[-2:]))[0]
     for ax, val, lab, cmap in zip(fig.subplots(1, 2),
                                   (np.abs(data), np.angle(data)),
-                                  ("|E| (arb. units)", "phase (rad)"),
+                                  ("|E| (per unit source amplitude)", "phase (rad)"),
                                   ("viridis", "twilight"), strict=True):
         m = ax.pcolormesh(_edges(h.x) * CM, _edges(h.y) * CM, val, cmap=cmap, shading="flat")
         ax.set_aspect("equal")
@@ -59,12 +59,16 @@ def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:
 
 def plot_image(images: Sequence[Image], titles: Sequence[str], *,
                outline: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+               marks: dict[str, np.ndarray | None] | None = None,
+               aperture: tuple[np.ndarray, np.ndarray] | None = None,
                suptitle: str = "") -> Figure:
     """|image| of one plane per panel, normalised to each panel's maximum.
 
-    ``outline = (x, y, mask)`` draws the true object's contour in white.
+    ``outline = (x, y, mask)`` draws the true object's contour in white;
+    ``marks`` labels points ``(x, y)`` in metres (``None`` values are skipped);
+    ``aperture = (x, y)`` draws the array's footprint.
     """
-    fig = Figure(figsize=(5 * len(images), 4.5), layout="constrained")
+    fig = Figure(figsize=(max(6.0, 5 * len(images)), 5.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(images)))
     for ax, img, title in zip(axes, images, titles, strict=True):
         a = np.abs(img.data.reshape((-1, *img.data.shape[-2:]))[0])
@@ -75,6 +79,16 @@ def plot_image(images: Sequence[Image], titles: Sequence[str], *,
             ox, oy, mask = outline
             ax.contour(ox * CM, oy * CM, mask.astype(float), levels=[0.5], colors="w",
                        linewidths=1.0)
+        if aperture is not None:
+            ex, ey = _edges(aperture[0]), _edges(aperture[1])
+            ax.add_patch(Rectangle((ex[0] * CM, ey[0] * CM), (ex[-1] - ex[0]) * CM,
+                                   (ey[-1] - ey[0]) * CM, fill=False, ec="c", ls="--",
+                                   label="array footprint"))
+        for label, xy in (marks or {}).items():
+            if xy is not None:
+                ax.plot(xy[0] * CM, xy[1] * CM, "c+", ms=14, mew=2, label=label)
+        if marks or aperture is not None:
+            ax.legend(loc="upper right", fontsize=8)
         ax.set_aspect("equal")
         ax.set_xlabel("x (cm)")
         ax.set_ylabel("y (cm)")
@@ -127,9 +141,12 @@ def plot_spectrum(p: np.ndarray, q: np.ndarray, spectrum: np.ndarray,
         (p1, p2), (q1, q2) = w.p_range, w.q_range
         ax.add_patch(Rectangle((p1, q1), p2 - p1, q2 - q1, fill=False, ec="c", lw=1.8,
                                label="spectral window" if i == 0 else None))
-    if nyquist is not None:
-        ax.add_patch(Rectangle((-nyquist, -nyquist), 2 * nyquist, 2 * nyquist, fill=False,
-                               ec="w", ls="--", lw=1, label=r"sampling limit $\pm\pi/s$"))
+    for i, w in enumerate(windows if nyquist is not None else []):
+        # The array samples |p|, |q| <= pi/s in its own frame: |p + p0| <= pi/s here.
+        cx, cy = w.center
+        ax.add_patch(Rectangle((cx - nyquist, cy - nyquist), 2 * nyquist, 2 * nyquist,
+                               fill=False, ec="w", ls="--", lw=1,
+                               label=r"sampling limit $\pm\pi/s$" if i == 0 else None))
     ax.set_xlabel("p (rad/m)")
     ax.set_ylabel("q (rad/m)")
     ax.set_aspect("equal")

@@ -61,6 +61,9 @@ class Hologram:
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
         f = check_frequency(frequency)
+        if source is not None and not (hasattr(source, "field") and hasattr(source, "reflected")):
+            raise ValueError("source must be a PlaneWave, PointSource, GaussianBeam or None, got "
+                             f"{type(source).__name__}")
         arr = arr.copy()  # the hologram owns its data: the caller's array is never shared
         arr.setflags(write=False)
         xa.setflags(write=False)

@@ -33,7 +33,8 @@ _POOL_SIZE = os.cpu_count() or 1
 def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
             medium: Medium | None = None, method: Literal["angular", "fresnel"] = "angular",
             pad: bool | float = True, upsample: int = 1, compensate_loss: bool = True,
-            dtype: type | None = None, progress: bool | None = None) -> Image:
+            fov: Literal["aperture", "full"] = "aperture", dtype: type | None = None,
+            progress: bool | None = None) -> Image:
     """Back-propagate a hologram to the planes at range ``z``.
 
     Parameters
@@ -54,6 +55,10 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     upsample : int
         Output pixels per element pitch. >1 interpolates the band-limited image
         exactly (zero padding of its spectrum); it adds no resolution.
+    fov : {"aperture", "full"}
+        Field of view: the aperture's extent (default), or the whole padded FFT
+        grid centred on it (to see what lies beside the array, e.g. the mirror
+        image of a horn held at its side).
     compensate_loss : bool
         In lossy layers, back-propagate each travelling component with its phase
         but without a second absorption ``exp(-Im(kz)*h)`` (at most 40 dB undone).
@@ -99,6 +104,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     scalar = np.ndim(z) == 0
     if method not in ("angular", "fresnel"):
         raise ValueError(f"method must be 'angular' or 'fresnel', got {method!r}")
+    if fov not in ("aperture", "full"):
+        raise ValueError(f"fov must be 'aperture' or 'full', got {fov!r}")
     if not isinstance(upsample, int | np.integer) or upsample < 1:
         raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
     if medium is not None and not isinstance(medium, Medium):
@@ -109,18 +116,26 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram")
     work = np.dtype(dtype) if dtype is not None else (
         np.complex64 if hologram.data.dtype == np.complex64 else np.complex128)
+    if work not in (np.complex64, np.complex128):
+        raise ValueError(f"dtype must be numpy.complex64 or numpy.complex128, got {dtype!r}")
     cls = AngularSpectrum if method == "angular" else Fresnel
     op = cls(hologram.data.shape[-2:], dx, dy, hologram.k, zs, medium, pad, work,
              compensate_loss=compensate_loss)
     H = op.spectrum(hologram.data)
     ny, nx = op.shape
     u = int(upsample)
-    oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     batch = H.shape[:-2]
     My, Mx = H.shape[-2:]
+    if fov == "full":
+        # The whole periodic grid, rolled so that the aperture sits in its middle.
+        oy, ox = u * My, u * Mx
+        sy, sx = u * ((My - ny) // 2), u * ((Mx - nx) // 2)
+    else:
+        oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
+        sy = sx = 0
     # Without crop or interpolation the products are computed in the output array itself
     # and transformed in place: one multiply and one inverse FFT per plane, no copies.
-    in_place = u == 1 and (My, Mx) == (ny, nx)
+    in_place = u == 1 and (My, Mx) == (ny, nx) and fov == "aperture"
     out = np.empty((*batch, zs.size, oy, ox), dtype=work)
     show = out.size > 2e8 if progress is None else progress
     bar = tqdm(total=zs.size, desc="migrate", unit="plane") if show else None
@@ -133,6 +148,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         if u > 1:
             prod = _zero_pad_spectrum(prod, u)
         planes = sfft.ifft2(prod, axes=(-2, -1), workers=op.workers, overwrite_x=True)
+        if fov == "full":
+            planes = np.roll(planes, (sy, sx), axis=(-2, -1))
         if not (in_place and np.may_share_memory(planes, out)):
             sl = planes[..., :oy, :ox]
             out[..., c0:c0 + len(Ucs), :, :] = sl * (u * u) if u > 1 else sl
@@ -140,8 +157,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
             bar.update(len(Ucs))
     if bar is not None:
         bar.close()
-    x = hologram.x[0] + np.arange(ox) * dx / u
-    y = hologram.y[0] + np.arange(oy) * dy / u
+    x = hologram.x[0] + (np.arange(ox) - sx) * dx / u
+    y = hologram.y[0] + (np.arange(oy) - sy) * dy / u
     data = out[..., 0, :, :] if scalar else out
     return Image(data, x, y, zs, hologram.frequency, method, has_z_axis=not scalar)
 

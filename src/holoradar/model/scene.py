@@ -18,35 +18,64 @@ __all__ = ["Aperture", "Scene"]
 
 @dataclass(frozen=True, eq=False)
 class Aperture:
-    """A receiver array on the plane z = 0 whose elements sit on a grid.
+    """A receiver array on the plane z = 0: a grid, or elements anywhere on the plane.
 
     Parameters
     ----------
     x, y : array_like
         Element coordinates along x and y, metres, strictly increasing (a
-        non-uniform grid is allowed; migration needs a uniform one). For
-        elements at arbitrary positions pass an ``(N, 2)`` array of positions to
-        :func:`holoradar.simulate` instead of an Aperture.
+        non-uniform grid is allowed; migration needs a uniform one).
+    elements : array_like, shape (N, 2), optional
+        Arbitrary element positions (x, y) in metres; use
+        :meth:`from_positions`. Such an aperture is not a grid:
+        :func:`holoradar.simulate` then returns the N element fields as an array.
 
     Examples
     --------
     >>> Aperture.paper().x.size, round(Aperture.paper().size[0], 3)
     (16, 0.4)
+    >>> Aperture.from_positions([[0.0, 0.0], [0.05, 0.01]]).points.shape
+    (2, 3)
     """
 
     x: np.ndarray
     y: np.ndarray
+    elements: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "x", as_axis(self.x, "x"))
         object.__setattr__(self, "y", as_axis(self.y, "y"))
+        if self.elements is not None:
+            try:
+                el = np.array(self.elements, dtype=float)
+            except (TypeError, ValueError):
+                el = np.empty((0, 0))
+            if el.ndim != 2 or el.shape[1] != 2 or el.shape[0] < 1 or not np.all(np.isfinite(el)):
+                raise ValueError("elements must be finite positions of shape (N, 2), metres")
+            el.setflags(write=False)
+            object.__setattr__(self, "elements", el)
+
+    @classmethod
+    def from_positions(cls, positions: np.ndarray) -> Aperture:
+        """Elements at arbitrary positions (N, 2) on the plane z = 0, metres."""
+        el = np.asarray(positions, dtype=float)
+        if el.ndim != 2 or el.shape[1] != 2:
+            raise ValueError(f"positions must have shape (N, 2), got {el.shape}")
+        xs, ys = np.unique(el[:, 0]), np.unique(el[:, 1])
+        return cls(xs, ys, el)
+
+    @property
+    def is_grid(self) -> bool:
+        """True for a grid (``simulate`` returns a Hologram)."""
+        return self.elements is None
 
     @classmethod
     def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
              center: tuple[float, float] = (0.0, 0.0)) -> Aperture:
         """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``."""
-        if int(n) < 1 or (ny is not None and int(ny) < 1):
-            raise ValueError(f"n and ny must be >= 1 elements, got n={n}, ny={ny}")
+        for name, v in (("n", n), ("ny", ny)):
+            if v is not None and (not float(v).is_integer() or int(v) < 1):
+                raise ValueError(f"{name} must be a whole number of elements >= 1, got {v!r}")
         if not pitch > 0 or (pitch_y is not None and not pitch_y > 0):
             raise ValueError(f"pitch must be > 0 m, got {pitch}, {pitch_y}")
         ny = int(n if ny is None else ny)
@@ -69,7 +98,9 @@ class Aperture:
 
     @property
     def points(self) -> np.ndarray:
-        """Element positions (N, 3), row-major over (y, x), z = 0."""
+        """Element positions (N, 3), z = 0; row-major over (y, x) for a grid."""
+        if self.elements is not None:
+            return np.c_[self.elements, np.zeros(len(self.elements))]
         X, Y = np.meshgrid(self.x, self.y)
         return np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
 

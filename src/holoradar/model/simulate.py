@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import check_frequency
+from .._validate import as_real, check_frequency
 from ..data.hologram import C0, Hologram
 from ..physics.green import free_space_green, layered_green
 from ..physics.medium import Medium
@@ -48,7 +48,8 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
     scene : Scene
         Medium, source and targets.
     aperture : Aperture or ndarray of shape (N, 2) or (N, 3)
-        Receiver grid, or arbitrary element positions (x, y[, z]) in metres.
+        Receiver array (:meth:`Aperture.grid`, :meth:`Aperture.paper`,
+        :meth:`Aperture.from_positions`), or element positions (x, y[, z]) in metres.
     frequency : float
         Hz.
     include_targets : bool
@@ -67,8 +68,8 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
     Returns
     -------
     Hologram
-        For an :class:`Aperture` (its ``source`` is the scene's), else a complex
-        array (N,) of element fields.
+        For a grid :class:`Aperture` (its ``source`` is the scene's); for elements
+        at arbitrary positions, a complex array (N,) of their fields.
 
     Examples
     --------
@@ -107,12 +108,13 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
     if include_direct:
         total += source.field(k, medium, pts)
     if snr_db is not None:
+        snr_db = as_real(snr_db, "snr_db")
         rng = np.random.default_rng(seed)
         power = float(np.mean(np.abs(total) ** 2))
         sigma = np.sqrt(power / 10 ** (snr_db / 10) / 2)
         total = total + sigma * (rng.standard_normal(total.shape)
                                  + 1j * rng.standard_normal(total.shape))
-    if isinstance(aperture, Aperture):
+    if isinstance(aperture, Aperture) and aperture.is_grid:
         return Hologram(total.reshape(aperture.y.size, aperture.x.size), aperture.x, aperture.y,
                         f, source=source)
     return total
@@ -142,7 +144,7 @@ def _planar_target(k: float, medium: Medium, source: object, t: PlanarTarget,
     pix = np.stack([X[sel], Y[sel], np.full(int(sel.sum()), t.z)], axis=1)
     s = np.zeros(fsub.shape, complex)
     s[sel] = fsub[sel] * source.field(k, medium, pix)
-    d = t.pixel
+    dx, dy = t.pitch
     # Lateral extent D that any useful ray must bridge, and a margin for diffraction.
     lo = np.minimum([xs[0], ys[0]], pts[:, :2].min(axis=0))
     hi = np.maximum([xs[-1], ys[-1]], pts[:, :2].max(axis=0))
@@ -154,7 +156,7 @@ def _planar_target(k: float, medium: Medium, source: object, t: PlanarTarget,
     # the object lands on a receiver.
     period = 4 * reach + D
     dp = 2 * np.pi / period
-    kmax = min(np.pi / d, k)  # the object pixels carry no more; air carries no more
+    kmax = min(np.pi / max(dx, dy), k)  # the pixels carry no more; air carries no more
     m = int(np.ceil(kmax / dp))
     p = np.arange(-m, m + 1) * dp
     P, Q = np.meshgrid(p, p)
@@ -168,7 +170,7 @@ def _planar_target(k: float, medium: Medium, source: object, t: PlanarTarget,
     # Continuous FT of the object's field: S(q, p) = sum s exp(-i(p x + q y)) d^2.
     Ey = np.exp(-1j * np.outer(p, ys))
     Ex = np.exp(-1j * np.outer(xs, p))
-    S = Ey @ s @ Ex * d * d
+    S = Ey @ s @ Ex * (dx * dy)
     A = S * U * dp * dp / (4 * np.pi**2)
     # Direct (non-uniform) inverse Fourier sum at the receivers.
     out = np.empty(len(pts), complex)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_axis, as_finite_complex, as_position, uniform_step
+from .._validate import as_axis, as_complex_scalar, as_finite_complex, as_position, uniform_step
 from . import shapes
 
 __all__ = ["PlanarTarget", "PointTarget"]
@@ -47,6 +47,7 @@ class PointTarget:
         if pos[2] <= 0:
             raise ValueError(f"position z must be > 0 (range beyond the aperture), got {pos[2]}")
         object.__setattr__(self, "position", pos)
+        object.__setattr__(self, "amplitude", as_complex_scalar(self.amplitude, "amplitude"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,17 +83,29 @@ class PlanarTarget:
         y = as_axis(self.y, "y", length=f.shape[0])
         uniform_step(x, "x")
         uniform_step(y, "y")
-        if not np.isfinite(self.z) or self.z <= 0:
-            raise ValueError(f"z must be a range > 0 m, got {self.z}")
-        object.__setattr__(self, "reflectivity", f.copy())
+        try:
+            z = float(self.z)
+        except (TypeError, ValueError):
+            z = np.nan
+        if not np.isfinite(z) or z <= 0:
+            raise ValueError(f"z must be a range > 0 m, got {self.z!r}")
+        f = f.copy()
+        for a in (f, x, y):
+            a.setflags(write=False)
+        object.__setattr__(self, "reflectivity", f)
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "y", y)
-        object.__setattr__(self, "z", float(self.z))
+        object.__setattr__(self, "z", z)
 
     @property
     def pixel(self) -> float:
-        """Pixel pitch, metres."""
+        """Pixel pitch along x, metres (see :attr:`pitch` for both)."""
         return float(self.x[1] - self.x[0])
+
+    @property
+    def pitch(self) -> tuple[float, float]:
+        """Pixel pitch ``(dx, dy)``, metres."""
+        return float(self.x[1] - self.x[0]), float(self.y[1] - self.y[0])
 
     @classmethod
     def from_mask(cls, mask: np.ndarray, x: np.ndarray, y: np.ndarray, z: float, *,

@@ -15,7 +15,8 @@ It is evaluated by Gauss-Legendre quadrature after the substitutions
 ``kappa = k*sin(theta)`` (propagating in air) and ``kappa = k*cosh(t)``
 (evanescent in air), which remove the square-root branch point at kappa = k.
 The number of nodes follows the largest phase of the integrand, so the rule
-resolves every oscillation (about 6 nodes per radian of phase).
+resolves every oscillation (2 nodes per radian of phase on top of 256, which
+converges to 1e-9 against closed forms in the tests).
 """
 
 from __future__ import annotations

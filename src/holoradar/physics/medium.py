@@ -106,13 +106,17 @@ class Medium:
     polarization: Polarization = "TE"
 
     def __post_init__(self) -> None:
-        zi = tuple(float(z) for z in self.z_interfaces)
+        try:
+            zi = tuple(float(z) for z in np.atleast_1d(np.asarray(self.z_interfaces, float)))
+        except (TypeError, ValueError):
+            raise ValueError("z_interfaces must be ranges in metres (numbers > 0), got "
+                             f"{self.z_interfaces!r}") from None
         if any(not np.isfinite(z) or z <= 0 for z in zi):
             raise ValueError("z_interfaces must be finite ranges > 0 m from the aperture "
                              f"(the aperture lies in air), got {self.z_interfaces}")
         if any(b <= a for a, b in itertools.pairwise(zi)):
             raise ValueError(f"z_interfaces must be strictly increasing, got {zi}")
-        eps = tuple(_check_eps(e, f"eps[{i}]") for i, e in enumerate(self.eps))
+        eps = tuple(_check_eps(e, f"eps[{i}]") for i, e in enumerate(np.atleast_1d(self.eps)))
         if len(eps) != len(zi) + 1:
             raise ValueError(f"eps must hold one permittivity per region ({len(zi) + 1}), got "
                              f"{len(eps)}")
@@ -153,7 +157,12 @@ class Medium:
         >>> round(sand.apparent_distance(0.42), 4)
         0.3759
         """
-        return cls((z_surface,), (1.0, eps), polarization)
+        try:
+            z = float(z_surface)
+        except (TypeError, ValueError):
+            raise ValueError(f"z_surface must be a range in metres > 0, got {z_surface!r}") \
+                from None
+        return cls((z,), (1.0, _check_eps(eps, "eps")), polarization)
 
     @classmethod
     def layered(cls, z_interfaces: Sequence[float], eps: Sequence[complex], *,
@@ -174,8 +183,8 @@ class Medium:
         >>> round(road.n(2).real, 3)
         3.004
         """
-        zi = tuple(z_interfaces)
-        ep = tuple(eps)
+        zi = tuple(np.atleast_1d(np.asarray(z_interfaces, dtype=float)))
+        ep = tuple(np.atleast_1d(np.asarray(eps, dtype=complex)))
         if len(zi) != len(ep):
             raise ValueError(f"eps must have one value per interface ({len(zi)}), got {len(ep)}")
         return cls(zi, (1.0, *ep), polarization)
@@ -240,13 +249,14 @@ class Medium:
                            eps_to: complex) -> np.ndarray:
         """Fresnel reflection of the field amplitude at one interface.
 
-        TE: ``(kz1 - kz2)/(kz1 + kz2)``; TM: ``(eps2 kz1 - eps1 kz2)/(eps2 kz1 + eps1 kz2)``
-        (the TM sign is that of the tangential magnetic field). Normal incidence
-        gives ``(n1 - n2)/(n1 + n2)`` for TE.
+        TE: ``(kz1 - kz2)/(kz1 + kz2)``; TM: ``(eps1 kz2 - eps2 kz1)/(eps2 kz1 + eps1 kz2)``,
+        signed as the tangential electric field (the negative of the usual
+        magnetic-field r_p), so that both give ``(n1 - n2)/(n1 + n2)`` at normal
+        incidence, as the scalar field of this model requires.
         """
         if self.polarization == "TE":
             return (kz_from - kz_to) / (kz_from + kz_to)
-        return (eps_to * kz_from - eps_from * kz_to) / (eps_to * kz_from + eps_from * kz_to)
+        return (eps_from * kz_to - eps_to * kz_from) / (eps_to * kz_from + eps_from * kz_to)
 
     # ------------------------------------------------------------ stack transfer
     def vertical_transfer(self, k: float, kappa2: np.ndarray, z_from: float,

@@ -22,17 +22,18 @@ at least twice each size) keeps the periodic FFT from wrapping the image.
 
 from __future__ import annotations
 
+import threading
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
-from functools import lru_cache
+from collections import OrderedDict
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.fft as sfft
 
 from .medium import Medium
 
-__all__ = ["AngularSpectrum", "Fresnel", "lateral_travel", "loss_exponent", "padded_shape",
-           "spectral_axes"]
+__all__ = ["AngularSpectrum", "Fresnel", "clear_transfer_cache", "lateral_travel",
+           "loss_exponent", "padded_shape", "spectral_axes"]
 
 
 def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[float, float]
@@ -118,10 +119,60 @@ def loss_exponent(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.
 _MAX_LOSS_GAIN = 100.0  # at most 40 dB of absorption is undone by compensate_loss
 
 
-@lru_cache(maxsize=64)
+class _TransferCache:
+    """Least-recently-used cache of transfer functions bounded in bytes, not entries.
+
+    Re-migrating the same geometry (a survey, a benchmark, a GUI sweep) reuses them;
+    the bound keeps a large volume from pinning gigabytes after it is done.
+    """
+
+    def __init__(self, max_bytes: int) -> None:
+        self.max_bytes = max_bytes
+        self._data: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self._bytes = 0
+        self._lock = threading.Lock()
+
+    def get(self, key: tuple, make: Callable[[], np.ndarray]) -> np.ndarray:
+        with self._lock:
+            if key in self._data:
+                self._data.move_to_end(key)
+                return self._data[key]
+        value = make()
+        with self._lock:
+            if key not in self._data and value.nbytes <= self.max_bytes:
+                self._data[key] = value
+                self._bytes += value.nbytes
+                while self._bytes > self.max_bytes:
+                    _, old = self._data.popitem(last=False)
+                    self._bytes -= old.nbytes
+        return value
+
+    def clear(self) -> None:
+        with self._lock:
+            self._data.clear()
+            self._bytes = 0
+
+
+_CACHE = _TransferCache(256 * 2**20)
+
+
+def clear_transfer_cache() -> None:
+    """Free the cached transfer functions (at most 256 MiB are kept)."""
+    _CACHE.clear()
+
+
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                       medium: Medium, band_limit: bool, dtype: np.dtype,
                       conjugate: bool, compensate_loss: bool = False) -> np.ndarray:
+    key = (shape, dx, dy, k, z, medium, band_limit, np.dtype(dtype).str, conjugate,
+           compensate_loss)
+    return _CACHE.get(key, lambda: _make_angular_transfer(*key[:7], np.dtype(dtype),
+                                                          conjugate, compensate_loss))
+
+
+def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
+                           medium: Medium, band_limit: bool, dtype: np.dtype,
+                           conjugate: bool, compensate_loss: bool) -> np.ndarray:
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
     U = medium.vertical_transfer(k, kappa2, z, 0.0)

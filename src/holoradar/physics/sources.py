@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .._validate import as_position
+from .._validate import as_complex_scalar, as_position, as_real
 from .green import free_space_green, layered_green
 from .medium import Medium
 
@@ -62,6 +62,8 @@ class PlaneWave:
     beta: float = 0.0
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "alpha", as_real(self.alpha, "alpha"))
+        object.__setattr__(self, "beta", as_real(self.beta, "beta"))
         if np.sin(self.alpha) ** 2 + np.sin(self.beta) ** 2 >= 1:
             raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
                              f"propagating wave), got alpha={self.alpha}, beta={self.beta}")
@@ -181,8 +183,9 @@ class PointSource:
         if nrm == 0:
             raise ValueError("axis must be a non-zero direction (x, y, z)")
         object.__setattr__(self, "axis", ax / nrm)
-        if not np.isfinite(self.pattern_exponent) or self.pattern_exponent < 0:
-            raise ValueError(f"pattern_exponent must be >= 0, got {self.pattern_exponent}")
+        object.__setattr__(self, "pattern_exponent",
+                           as_real(self.pattern_exponent, "pattern_exponent", nonnegative=True))
+        object.__setattr__(self, "amplitude", as_complex_scalar(self.amplitude, "amplitude"))
 
     def _check_air(self, medium: Medium) -> None:
         if not medium.is_free_space and self.position[2] >= medium.z_interfaces[0]:
@@ -268,33 +271,65 @@ class GaussianBeam:
     amplitude: complex = 1.0
 
     def __post_init__(self) -> None:
-        if not np.isfinite(self.waist) or self.waist <= 0:
-            raise ValueError(f"waist must be a positive radius in metres, got {self.waist}")
+        w = as_real(self.waist, "waist") if not isinstance(self.waist, str) else -1.0
+        if w <= 0:
+            raise ValueError(f"waist must be a positive radius in metres, got {self.waist!r}")
+        object.__setattr__(self, "waist", w)
         object.__setattr__(self, "center", as_position(self.center, "center"))
+        object.__setattr__(self, "alpha", as_real(self.alpha, "alpha"))
+        object.__setattr__(self, "beta", as_real(self.beta, "beta"))
+        if np.sin(self.alpha) ** 2 + np.sin(self.beta) ** 2 >= 1:
+            raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
+                             f"propagating beam), got alpha={self.alpha}, beta={self.beta}")
+        object.__setattr__(self, "amplitude", as_complex_scalar(self.amplitude, "amplitude"))
 
-    def _spectrum(self, k: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    def _spectrum(self, k: float, pts: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """Angular spectrum on a grid fine enough that nothing wraps onto ``pts``.
+
+        The quadrature makes the field periodic with period ``2*pi/dp``; the period
+        is set larger than twice the farthest point's distance from the beam plus
+        eight beam radii there, so the periodic copies of the beam are negligible
+        (exp(-16)) at every point.
+        """
         w = self.waist
         p0, q0 = k * np.sin(self.alpha), k * np.sin(self.beta)
+        dz = np.abs(pts[:, 2] - self.center[2])
+        zr = k * w * w / 2
+        w_far = w * np.sqrt(1 + (dz.max(initial=0.0) / zr) ** 2)
+        tilt = np.hypot(np.tan(np.arcsin(np.clip(np.sin(self.alpha), -0.99, 0.99))),
+                        np.tan(np.arcsin(np.clip(np.sin(self.beta), -0.99, 0.99))))
+        rho = np.hypot(pts[:, 0] - self.center[0], pts[:, 1] - self.center[1]) + dz * tilt
+        period = 2 * (rho.max(initial=0.0) + 4 * w_far) + 8 * w
+        dp = 2 * np.pi / period
         half = 8.0 / w  # exp(-16): the spectrum beyond is negligible
-        n = 129
-        p = np.linspace(p0 - half, p0 + half, n)
-        q = np.linspace(q0 - half, q0 + half, n)
+        m = int(np.ceil(half / dp))
+        if 2 * m + 1 > 1025:
+            raise ValueError("points lie too far from the GaussianBeam for its waist "
+                             f"({w} m): the quadrature would need {2 * m + 1}^2 nodes")
+        p = p0 + np.arange(-m, m + 1) * dp
+        q = q0 + np.arange(-m, m + 1) * dp
         P, Q = np.meshgrid(p, q)
         A = self.amplitude * np.pi * w * w * np.exp(-((P - p0) ** 2 + (Q - q0) ** 2) * w * w / 4)
         A = np.where(P * P + Q * Q < k * k, A, 0)
-        dpq = (p[1] - p[0]) * (q[1] - q[0])
-        return P, Q, A, dpq
+        return P, Q, A, dp * dp
 
     def _sum(self, P: np.ndarray, Q: np.ndarray, S: np.ndarray, pts: np.ndarray) -> np.ndarray:
         x = pts[:, 0] - self.center[0]
         y = pts[:, 1] - self.center[1]
-        ph = np.exp(1j * (np.outer(x, P.ravel()) + np.outer(y, Q.ravel())))
-        return ph @ S.ravel()
+        keep = S != 0
+        Pk, Qk, Sk = P[keep], Q[keep], S[keep]
+        out = np.empty(len(pts), complex)
+        step = max(1, int(2e7 // max(Pk.size, 1)))  # bound the phase matrix's memory
+        for c0 in range(0, len(pts), step):
+            sl = slice(c0, c0 + step)
+            out[sl] = np.exp(1j * (np.outer(x[sl], Pk) + np.outer(y[sl], Qk))) @ Sk
+        return out
 
     def field(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
         """Incident field at ``points`` (N, 3)."""
         pts = _points(points)
-        P, Q, A, dpq = self._spectrum(k)
+        P, Q, A, dpq = self._spectrum(k, pts)
         k2 = P * P + Q * Q
         out = np.empty(len(pts), complex)
         for z in np.unique(pts[:, 2]):
@@ -311,9 +346,12 @@ class GaussianBeam:
         pts = _points(points)
         if medium.is_free_space:
             return np.zeros(len(pts), complex)
-        P, Q, A, dpq = self._spectrum(k)
-        k2 = P * P + Q * Q
         z0 = medium.z_interfaces[0]
+        # The reflected beam travels as far as from its mirror waist: size the grid for it.
+        mirror = pts.copy()
+        mirror[:, 2] = 2 * z0 - pts[:, 2]
+        P, Q, A, dpq = self._spectrum(k, mirror)
+        k2 = P * P + Q * Q
         kz0 = medium.kz(k, k2, 0)
         R = medium.reflection(k, k2)
         out = np.empty(len(pts), complex)
