@@ -137,6 +137,18 @@ def test_gaussian_beam_waist_and_rayleigh_range():
     assert abs(far[0]) < 1e-6
 
 
+def test_horn_behind_the_array_lights_it_in_layered_ground():
+    # A horn 5 cm behind the aperture plane: its direct wave at the elements is
+    # exp(ikR)/R * cos(psi)^m, the same with or without a ground beyond.
+    horn = hr.PointSource((0.0, 0.0, -0.05), pattern_exponent=2.0)
+    pts = np.array([[0.05, 0.0, 0.0], [0.0, 0.1, 0.0]])
+    d = pts - horn.position
+    R = np.linalg.norm(d, axis=1)
+    ref = np.exp(1j * K * R) / R * (d[:, 2] / R) ** 2
+    for m in (hr.Medium.free_space(), hr.Medium.half_space(0.3, 2.5)):
+        np.testing.assert_allclose(horn.field(K, m, pts), ref, rtol=1e-9)
+
+
 def test_horn_pattern():
     horn = hr.PointSource((0.0, 0.0, 0.0), pattern_exponent=2.0)
     m = hr.Medium.free_space()

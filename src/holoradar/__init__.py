@@ -18,6 +18,13 @@ from . import theory
 from ._validate import AliasingWarning
 from .data.hologram import C0, Hologram, Image
 from .imaging.migrate import migrate
+from .imaging.reflection import (
+    FitWarning,
+    SuppressionReport,
+    estimate_permittivity,
+    suppress_surface,
+)
+from .imaging.synthesis import align_phases, synthesize
 from .model.scene import Aperture, Scene
 from .model.simulate import simulate
 from .model.targets import PlanarTarget, PointTarget
@@ -32,6 +39,7 @@ __all__ = [
     "AliasingWarning",
     "AngularSpectrum",
     "Aperture",
+    "FitWarning",
     "Fresnel",
     "GaussianBeam",
     "Hologram",
@@ -42,9 +50,14 @@ __all__ = [
     "PointSource",
     "PointTarget",
     "Scene",
+    "SuppressionReport",
     "__version__",
+    "align_phases",
+    "estimate_permittivity",
     "migrate",
     "permittivity",
     "simulate",
+    "suppress_surface",
+    "synthesize",
     "theory",
 ]

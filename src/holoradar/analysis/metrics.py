@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..data.hologram import Image
+from ..model.targets import PlanarTarget
 
-__all__ = ["main_lobe_width", "peak_position"]
+__all__ = ["main_lobe_width", "peak_position", "shape_correlation"]
 
 
 def _parabolic(a: np.ndarray, i: int, *, log: bool = False) -> float:
@@ -76,3 +77,37 @@ def main_lobe_width(profile: np.ndarray, coords: np.ndarray) -> float:
     right = coords[j] + _parabolic(-a, j) * step
     left = coords[m] + _parabolic(-a, m) * step
     return float(right - left)
+
+
+def shape_correlation(image: Image, target: PlanarTarget) -> float:
+    """Pearson correlation between ``|image|`` and a planar target's footprint.
+
+    The target's reflectivity mask (|f| > 0) is sampled at the image's pixels
+    (nearest target pixel; 0 outside its grid) and correlated with the image
+    magnitude: 1 for an image proportional to the mask, ~0 for no resemblance.
+    Used to judge how well an image shows a shape (paper Figs. 11, 22).
+
+    Examples
+    --------
+    >>> from holoradar import Image, PlanarTarget
+    >>> t = PlanarTarget.from_shape("disk", 0.4, diameter=0.1)
+    >>> x = np.linspace(-0.1, 0.1, 41)
+    >>> m = (x[None, :] ** 2 + x[:, None] ** 2 <= 0.05**2).astype(float)
+    >>> round(shape_correlation(Image(m, x, x, np.array([0.4]), 1e10, has_z_axis=False), t), 2)
+    1.0
+    """
+    a = np.abs(image.data)
+    if image.has_z_axis:
+        a = a.reshape((-1, *a.shape[-2:])).max(axis=0)
+    a = a.reshape((-1, *a.shape[-2:]))[0]
+    ix = np.clip(np.round((image.x - target.x[0]) / (target.x[1] - target.x[0])).astype(int),
+                 -1, target.x.size)
+    iy = np.clip(np.round((image.y - target.y[0]) / (target.y[1] - target.y[0])).astype(int),
+                 -1, target.y.size)
+    inside = ((iy[:, None] >= 0) & (iy[:, None] < target.y.size)
+              & (ix[None, :] >= 0) & (ix[None, :] < target.x.size))
+    mask = np.zeros(a.shape)
+    fy = np.clip(iy, 0, target.y.size - 1)
+    fx = np.clip(ix, 0, target.x.size - 1)
+    mask[inside] = (np.abs(target.reflectivity) > 0)[np.ix_(fy, fx)][inside]
+    return float(np.corrcoef(a.ravel(), mask.ravel())[0, 1])

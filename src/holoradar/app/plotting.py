@@ -130,17 +130,32 @@ def plot_depth_sweep(img: Image, *, y: float = 0.0, marks: dict[str, float] | No
 
 def plot_spectrum(p: np.ndarray, q: np.ndarray, spectrum: np.ndarray,
                   windows: Sequence[SpectralWindow], *, nyquist: float | None = None,
+                  union: bool = False,
                   title: str = "Object spectrum and spectral window") -> Figure:
-    """|F(p, q)| (dB) with each view's spectral window drawn as a rectangle (rad/m)."""
+    """|F(p, q)| (dB) with each view's spectral window drawn as a rectangle (rad/m).
+
+    ``union=True`` (several views) shades the union of the windows: the object
+    frequencies that a coherent synthesis of the views records (paper Fig. 11).
+    """
     fig = Figure(figsize=(6.2, 5.2), layout="constrained")
     ax = fig.subplots()
     s = np.abs(spectrum)
     db = 20 * np.log10(np.maximum(s / s.max(), 1e-4))
     m = ax.pcolormesh(_edges(p), _edges(q), db, cmap="magma", vmin=-40, vmax=0, shading="flat")
+    multi = len(windows) > 1
     for i, w in enumerate(windows):
         (p1, p2), (q1, q2) = w.p_range, w.q_range
-        ax.add_patch(Rectangle((p1, q1), p2 - p1, q2 - q1, fill=False, ec="c", lw=1.8,
-                               label="spectral window" if i == 0 else None))
+        ax.add_patch(Rectangle((p1, q1), p2 - p1, q2 - q1, fill=False,
+                               ec=f"C{i % 10}" if multi else "c", lw=1.8,
+                               label=f"view {i + 1}" if multi else "spectral window"))
+    if union and multi:
+        P, Q = np.meshgrid(p, q)
+        covered = np.zeros(P.shape, bool)
+        for w in windows:
+            covered |= w.contains(P, Q)
+        ax.contourf(p, q, covered.astype(float), levels=[0.5, 1.5], colors=["w"], alpha=0.18)
+        ax.contour(p, q, covered.astype(float), levels=[0.5], colors="w", linewidths=2.2)
+        ax.plot([], [], "w-", lw=2.2, label="union (coherent synthesis)")
     for i, w in enumerate(windows if nyquist is not None else []):
         # The array samples |p|, |q| <= pi/s in its own frame: |p + p0| <= pi/s here.
         cx, cy = w.center

@@ -118,7 +118,7 @@ def ray_direction(k: float, medium: Medium, src: np.ndarray, pts: np.ndarray) ->
     # Thickness crossed in each region, per point.
     hs = []
     for m in range(medium.n_regions):
-        top = medium.top_of(m)
+        top = -np.inf if m == 0 else medium.top_of(m)  # the air extends behind the array
         bottom = medium.z_interfaces[m] if m < len(medium.z_interfaces) else np.inf
         lo = np.minimum(src[2], pts[:, 2])
         hi = np.maximum(src[2], pts[:, 2])

@@ -1,0 +1,166 @@
+"""Multi-view synthesis (PHYSICS.md section 5, paper Figs. 11 and 22)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from conftest import F0
+from holoradar import theory
+from holoradar.analysis.metrics import main_lobe_width, peak_position, shape_correlation
+
+LAM = hr.C0 / F0
+K = 2 * np.pi / LAM
+SAND = hr.Medium.half_space(0.30, 2.5 * (1 + 0.005j))
+
+
+def _tiled_views(dist=1.0, n=33, target=(0.013, 0.0, 1.0)):
+    """Three plane waves whose windows tile p: tilts p_k = 2*mu*k, k = -1, 0, 1."""
+    ap = hr.Aperture.grid(n, LAM / 2)  # odd: an element on the axis
+    mu = theory.spectral_window(F0, n * LAM / 2, dist).mu
+    tg = hr.PointTarget(target)
+    views = [hr.simulate(hr.Scene(source=hr.PlaneWave(np.arcsin(2 * mu * j / K), 0.0),
+                                  targets=[tg]), ap, F0) for j in (-1, 0, 1)]
+    return views, mu
+
+
+def _width(img: hr.Image) -> float:
+    _, y, _ = peak_position(img)
+    iy = int(np.argmin(np.abs(img.y - y)))
+    return main_lobe_width(img.data[iy], img.x) / 2
+
+
+def test_coherent_synthesis_narrows_to_the_union_window():
+    # Union of three tiling windows: half-width 3 mu, so the first null of the point
+    # image moves from pi/mu to pi/(3 mu) (PHYSICS.md section 5); issue's bound 15%.
+    views, mu = _tiled_views()
+    img = hr.synthesize(views, 1.0, mode="coherent", upsample=8)
+    assert abs(_width(img) / (np.pi / (3 * mu)) - 1) < 0.15
+    assert abs(peak_position(img)[0] - 0.013) < LAM / 20
+
+
+def test_amplitude_synthesis_does_not_narrow():
+    views, mu = _tiled_views()
+    img = hr.synthesize(views, 1.0, mode="amplitude", upsample=8)
+    assert abs(_width(img) / (np.pi / mu) - 1) < 0.15
+    assert np.isrealobj(img.data)
+
+
+@pytest.mark.parametrize("scene", ["point", "letter_r"])
+def test_quasi_coherent_recovers_coherent_under_random_view_phases(scene):
+    # Each view gets an unknown constant phase (a drifting reference); the estimator
+    # must undo it: correlation with the coherent image > 0.95 (issue 3). The relative
+    # phase of two views is carried only by the object frequencies both record, so an
+    # extended scene needs overlapping windows: tilts of 0.75 mu overlap them by a
+    # quarter. (A point, whose spectrum is flat, is aligned even by tiling windows.)
+    if scene == "point":
+        views, _ = _tiled_views()
+        z = 1.0
+    else:
+        z = 0.5
+        mu = theory.spectral_window(F0, 0.4, z).mu
+        s = np.arcsin(0.75 * mu / K)
+        R = hr.PlanarTarget.from_shape("letter_r", z, reflection=-1, width=0.10, height=0.15)
+        ap = hr.Aperture.grid(20, 0.02)
+        views = [hr.simulate(hr.Scene(source=hr.PlaneWave(a, b), targets=[R]), ap, F0)
+                 for a in (-s, s) for b in (-s, s)]
+    rng = np.random.default_rng(7)
+    drifted = [hr.Hologram(v.data * np.exp(1j * rng.uniform(-np.pi, np.pi)), v.x, v.y,
+                           v.frequency, source=v.source) for v in views]
+    c = hr.synthesize(views, z, upsample=2).data
+    q = hr.synthesize(drifted, z, mode="quasi-coherent", upsample=2).data
+    corr = abs(np.vdot(c, q)) / (np.linalg.norm(c) * np.linalg.norm(q))
+    assert corr > 0.95
+
+
+def _views(target: hr.PlanarTarget, sources, medium=None):
+    ap = hr.Aperture.paper()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hr.AliasingWarning)
+        return [hr.simulate(hr.Scene(medium or hr.Medium.free_space(), s, [target]), ap, F0,
+                            include_surface=False) for s in sources]
+
+
+def _shape_gain(views, target, z, medium=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hr.AliasingWarning)
+        img, per_view = hr.synthesize(views, z, medium=medium, upsample=8, return_views=True)
+    single = [shape_correlation(hr.Image(v, img.x, img.y, img.z, F0, has_z_axis=False), target)
+              for v in per_view]
+    return shape_correlation(img, target), max(single)
+
+
+def test_letter_r_four_plane_waves_correlates_better():
+    # Paper Fig. 11: letter R at 0.5 m, four tilts whose windows tile a 2 x 2 square.
+    z = 0.5
+    s = np.arcsin(theory.spectral_window(F0, 0.4, z).mu / K)
+    R = hr.PlanarTarget.from_shape("letter_r", z, reflection=-1, width=0.10, height=0.15)
+    views = _views(R, [hr.PlaneWave(a, b) for a in (-s, s) for b in (-s, s)])
+    synth, best_single = _shape_gain(views, R, z)
+    assert synth > best_single
+
+
+def test_ring_in_sand_lit_from_one_side_correlates_better():
+    # Paper Figs. 21-22: 18 cm aluminium ring 12 cm deep in sand, horn moved along one
+    # side of the array; views migrated through the sand and summed coherently.
+    ring = hr.PlanarTarget.from_shape("ring", 0.42, reflection=-1, outer_diameter=0.18,
+                                      width=0.02)
+    horns = [hr.PointSource((x0, -0.25, 0.0), pattern_exponent=2, axis=(0, 0.25, 0.42))
+             for x0 in np.linspace(-0.15, 0.15, 6)]
+    synth, best_single = _shape_gain(_views(ring, horns, SAND), ring, 0.42, SAND)
+    assert synth > best_single
+
+
+def test_disk_in_sand_correlates_better():
+    disk = hr.PlanarTarget.from_shape("disk", 0.42, reflection=-1, diameter=0.11)
+    horns = [hr.PointSource((x0, y0, 0.0), pattern_exponent=2, axis=(-x0, -y0, 0.42))
+             for x0 in (-0.25, 0.25) for y0 in (-0.25, 0.25)]
+    synth, best_single = _shape_gain(_views(disk, horns, SAND), disk, 0.42, SAND)
+    assert synth > best_single
+
+
+def test_synthesis_through_the_ground_focuses_a_buried_point():
+    # Incident and scattered fields both cross the surface: with the medium, the views'
+    # phases line up at the true position (lambda_m/4), and the synthesis is sharper
+    # than any single view.
+    target = (0.02, -0.01, 0.42)
+    horns = [hr.PointSource((x0, -0.22, 0.0)) for x0 in (-0.2, 0.0, 0.2)]
+    ap = hr.Aperture.grid(27, LAM / 2)
+    views = [hr.simulate(hr.Scene(SAND, s, [hr.PointTarget(target)]), ap, F0,
+                         include_surface=False) for s in horns]
+    img = hr.synthesize(views, [0.40, 0.42, 0.44], medium=SAND, upsample=4)
+    x, y, _ = peak_position(img)
+    lam_m = LAM / SAND.n(1).real
+    assert np.hypot(x - target[0], y - target[1]) < lam_m / 4
+    single = hr.migrate(views[1], 0.42, medium=SAND, upsample=4)
+    assert _width(img.plane(0.42)) < _width(single)
+
+
+def test_synthesis_bad_input():
+    views, _ = _tiled_views(n=9)
+    other_f = hr.Hologram(views[1].data, views[1].x, views[1].y, 10e9, source=views[1].source)
+    with pytest.raises(ValueError, match="views must share one frequency"):
+        hr.synthesize([views[0], other_f], 1.0)
+    other_grid = hr.Hologram(views[1].data, views[1].x + 0.001, views[1].y, F0,
+                             source=views[1].source)
+    with pytest.raises(ValueError, match="views must share one aperture"):
+        hr.synthesize([views[0], other_grid], 1.0)
+    no_source = hr.Hologram(views[1].data, views[1].x, views[1].y, F0)
+    with pytest.raises(ValueError, match=r"holograms\[1\] has no source"):
+        hr.synthesize([views[0], no_source], 1.0)
+    with pytest.raises(ValueError, match="mode must be"):
+        hr.synthesize(views, 1.0, mode="loud")
+    with pytest.raises(ValueError, match="at least one Hologram"):
+        hr.synthesize([], 1.0)
+
+
+def test_spectral_coverage_figure(tmp_path):
+    from holoradar.app.plotting import plot_spectrum, to_png
+
+    wins = [theory.spectral_window(F0, 0.4, 0.5, alpha0=a) for a in (-0.4, 0.0, 0.4)]
+    p = np.linspace(-300, 300, 121)
+    png = to_png(plot_spectrum(p, p, np.ones((121, 121)), wins, union=True))
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
