@@ -64,7 +64,7 @@ def test_quasi_coherent_recovers_coherent_under_random_view_phases(scene):
         mu = theory.spectral_window(F0, 0.4, z).mu
         s = np.arcsin(0.75 * mu / K)
         R = hr.PlanarTarget.from_shape("letter_r", z, reflection=-1, width=0.10, height=0.15)
-        ap = hr.Aperture.grid(20, 0.02)
+        ap = hr.Aperture.grid(27, 0.015)
         views = [hr.simulate(hr.Scene(source=hr.PlaneWave(a, b), targets=[R]), ap, F0)
                  for a in (-s, s) for b in (-s, s)]
     rng = np.random.default_rng(7)

@@ -93,8 +93,8 @@ def shape_correlation(image: Image, target: PlanarTarget) -> float:
     >>> t = PlanarTarget.from_shape("disk", 0.4, diameter=0.1)
     >>> x = np.linspace(-0.1, 0.1, 41)
     >>> m = (x[None, :] ** 2 + x[:, None] ** 2 <= 0.05**2).astype(float)
-    >>> round(shape_correlation(Image(m, x, x, np.array([0.4]), 1e10, has_z_axis=False), t), 2)
-    1.0
+    >>> shape_correlation(Image(m, x, x, np.array([0.4]), 1e10, has_z_axis=False), t) > 0.98
+    True
     """
     a = np.abs(image.data)
     if image.has_z_axis:

@@ -495,7 +495,7 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     >>> import holoradar as hr
     >>> m = hr.Medium.half_space(0.3, 4.0)
     >>> h = hr.simulate(hr.Scene(m, hr.PointSource((0.0, 0.0, -0.05))),
-    ...                 hr.Aperture.grid(24, 0.015), 9.9e9)
+    ...                 hr.Aperture.grid(24, 0.015), 9.9e9, include_direct=True)
     >>> eps, std = estimate_permittivity(h, hr.Medium.half_space(0.3, 3.0))
     >>> round(eps.real, 2)
     4.0
