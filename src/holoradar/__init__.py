@@ -24,6 +24,7 @@ from .imaging.reflection import (
     estimate_permittivity,
     suppress_surface,
 )
+from .imaging.stream import StreamImager
 from .imaging.synthesis import align_phases, synthesize
 from .model.scene import Aperture, Scene
 from .model.simulate import simulate
@@ -50,6 +51,7 @@ __all__ = [
     "PointSource",
     "PointTarget",
     "Scene",
+    "StreamImager",
     "SuppressionReport",
     "__version__",
     "align_phases",

@@ -61,20 +61,28 @@ def plot_image(images: Sequence[Image], titles: Sequence[str], *,
                outline: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
                marks: dict[str, np.ndarray | None] | None = None,
                aperture: tuple[np.ndarray, np.ndarray] | None = None,
-               suptitle: str = "") -> Figure:
+               db_range: float | None = None, suptitle: str = "") -> Figure:
     """|image| of one plane per panel, normalised to each panel's maximum.
 
     ``outline = (x, y, mask)`` draws the true object's contour in white;
     ``marks`` labels points ``(x, y)`` in metres (``None`` values are skipped);
-    ``aperture = (x, y)`` draws the array's footprint.
+    ``aperture = (x, y)`` draws the array's footprint. ``db_range`` switches to
+    ``20*log10(|E|)`` on one scale for all panels, relative to the first panel's
+    maximum, over that many dB (to show how much a processing step removed).
     """
     fig = Figure(figsize=(max(6.0, 5 * len(images)), 5.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(images)))
+    ref = float(np.abs(images[0].data).max()) or 1.0
     for ax, img, title in zip(axes, images, titles, strict=True):
         a = np.abs(img.data.reshape((-1, *img.data.shape[-2:]))[0])
-        a = a / a.max() if a.max() > 0 else a
+        if db_range is None:
+            a = a / a.max() if a.max() > 0 else a
+            vmin, vmax, label = 0.0, 1.0, "|E| / max"
+        else:
+            a = 20 * np.log10(np.maximum(a / ref, 10 ** (-db_range / 20)))
+            vmin, vmax, label = -db_range, 0.0, "|E| (dB re first panel's max)"
         m = ax.pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, a, cmap="inferno",
-                          vmin=0, vmax=1, shading="flat")
+                          vmin=vmin, vmax=vmax, shading="flat")
         if outline is not None:
             ox, oy, mask = outline
             ax.contour(ox * CM, oy * CM, mask.astype(float), levels=[0.5], colors="w",
@@ -93,7 +101,7 @@ def plot_image(images: Sequence[Image], titles: Sequence[str], *,
         ax.set_xlabel("x (cm)")
         ax.set_ylabel("y (cm)")
         ax.set_title(f"{title}\nz = {img.z[0] * CM:.1f} cm")
-        fig.colorbar(m, ax=ax, label="|E| / max")
+        fig.colorbar(m, ax=ax, label=label)
     if suptitle:
         fig.suptitle(suptitle)
     return fig
