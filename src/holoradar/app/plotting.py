@@ -92,9 +92,9 @@ def plot_image(images: Sequence[Image], titles: Sequence[str], *,
             ax.add_patch(Rectangle((ex[0] * CM, ey[0] * CM), (ex[-1] - ex[0]) * CM,
                                    (ey[-1] - ey[0]) * CM, fill=False, ec="c", ls="--",
                                    label="array footprint"))
-        for label, xy in (marks or {}).items():
+        for name, xy in (marks or {}).items():
             if xy is not None:
-                ax.plot(xy[0] * CM, xy[1] * CM, "c+", ms=14, mew=2, label=label)
+                ax.plot(xy[0] * CM, xy[1] * CM, "c+", ms=14, mew=2, label=name)
         if marks or aperture is not None:
             ax.legend(loc="upper right", fontsize=8)
         ax.set_aspect("equal")

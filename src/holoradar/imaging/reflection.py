@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -278,7 +278,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     D = None
     if direct:
         D = free_space_green(k, src.position, pts)
-        if src.pattern_exponent:
+        if src.has_pattern:
             d = pts - src.position
             D = D * src.pattern(d / np.linalg.norm(d, axis=1, keepdims=True))
     h = data.ravel()
@@ -463,8 +463,7 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
     def glare_of(e: np.ndarray) -> np.ndarray:
         eps = complex(max(e[0], 1e-3), max(e[1], 0.0))
         m = Medium(medium.z_interfaces, (1.0, eps, *medium.eps[2:]), medium.polarization)
-        return PointSource(src.position, src.pattern_exponent, src.axis, 1.0).reflected(
-            k, m, pts)
+        return replace(src, amplitude=1.0).reflected(k, m, pts)
 
     th = transform(h)
     tD = None if D is None else transform(D)
@@ -508,7 +507,7 @@ def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
     millimetre is 0.2 rad), so only |V| is used: for a ground denser than air
     V = -|V| and n = (1 + |V|)/(1 - |V|), real (loss is not seen this way).
     """
-    pat = src.pattern(np.array([[0.0, 0.0, 1.0]]))[0] if src.pattern_exponent else 1.0
+    pat = src.pattern(np.array([[0.0, 0.0, 1.0]]))[0] if src.has_pattern else 1.0
     if pat == 0:
         return complex(np.nan), complex(np.nan)
     V = -abs(a * np.exp(k * b) / (ref * pat))

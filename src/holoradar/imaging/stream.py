@@ -110,7 +110,7 @@ class StreamImager:
             _, rep = suppress_surface(v, medium, v.source, "gaussian")
             theta.append([rep.parameters["x"], rep.parameters["y"], rep.parameters["b"]])
             d = free_space_green(self.k, v.source.position, self.pts)
-            if v.source.pattern_exponent:
+            if v.source.has_pattern:
                 r = self.pts - v.source.position
                 d = d * v.source.pattern(r / np.linalg.norm(r, axis=1, keepdims=True))
             D.append(d)

@@ -66,7 +66,7 @@ def incident_on_plane(source: object, k: float, medium: Medium, x: np.ndarray, y
     amp = np.interp(rho, r, np.abs(g))
     phase = np.interp(rho, r, np.unwrap(np.angle(g)))
     e0 = source.amplitude * amp * np.exp(1j * phase)
-    if source.pattern_exponent:
+    if source.has_pattern:
         pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z)], axis=1)
         e0 = e0 * source.pattern(ray_direction(k, medium, src, pts)).reshape(X.shape)
     return e0

@@ -157,6 +157,11 @@ class PointSource:
         Direction of the horn's boresight (normalised here); default +z.
     amplitude : complex, optional
         Complex amplitude: the field is ``amplitude * exp(i*k*R)/R`` on axis.
+    dipole : bool, optional
+        A short dipole along ``axis`` instead of a horn: the field component along
+        the dipole, ``1 - (d . axis)^2`` for a ray direction d (0 along the wire),
+        replaces the cosine pattern (a gprMax ``hertzian_dipole`` seen through
+        its parallel field component).
 
     Notes
     -----
@@ -175,6 +180,7 @@ class PointSource:
     pattern_exponent: float = 0.0
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     amplitude: complex = 1.0
+    dipole: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", as_position(self.position, "position"))
@@ -192,8 +198,15 @@ class PointSource:
             raise ValueError(f"PointSource position z={self.position[2]} m must lie above the "
                              f"ground surface at z={medium.z_interfaces[0]} m")
 
+    @property
+    def has_pattern(self) -> bool:
+        """True unless the source is isotropic."""
+        return bool(self.pattern_exponent) or self.dipole
+
     def pattern(self, directions: np.ndarray) -> np.ndarray:
         """Amplitude pattern for unit ``directions`` (N, 3)."""
+        if self.dipole:
+            return 1 - (directions @ self.axis) ** 2
         if self.pattern_exponent == 0:
             return np.ones(len(directions))
         c = np.clip(directions @ self.axis, 0, None)
@@ -205,7 +218,7 @@ class PointSource:
         pts = _points(points)
         g = (free_space_green(k, self.position, pts) if medium.is_free_space
              else layered_green(k, medium, self.position, pts))
-        if self.pattern_exponent:
+        if self.has_pattern:
             g = g * self.pattern(ray_direction(k, medium, self.position, pts))
         return self.amplitude * g
 
@@ -224,7 +237,7 @@ class PointSource:
         if medium.is_free_space:
             return np.zeros(len(pts), complex)
         g = layered_green(k, medium, self.position, pts, kind="reflected")
-        if self.pattern_exponent:
+        if self.has_pattern:
             img = self.mirror_position(medium)
             d = pts - img
             d /= np.linalg.norm(d, axis=1, keepdims=True)
