@@ -95,7 +95,9 @@ class StreamImager:
             mag = np.abs(e0)
             p = np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
             ph.append(np.roll(p, (-self.roll[0], -self.roll[1]), axis=(0, 1)))
-        self.phasors = np.stack(ph).astype(self.uc.dtype)
+        # The inverse FFT onto the u-times finer grid normalises by u^2 too much: the
+        # factor rides on the phasors, saving a pass over the K images every frame.
+        self.phasors = np.stack(ph).astype(self.uc.dtype) * (self.u * self.u)
         X, Y = np.meshgrid(h0.x, h0.y)
         self.pts = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
         if suppress:
@@ -130,24 +132,47 @@ class StreamImager:
         dG_dR = G * (1j * self.k - 1 / R)
         return G, dG_dR * (-dx / R), dG_dR * (-dy / R), dG_dR * (-1j * s / R)
 
-    def _fit(self, h: np.ndarray, steps: int = 1) -> np.ndarray:
-        """Gauss-Newton steps for all views at once; returns the fitted glare + direct."""
-        for it in range(steps + 1):
-            G, *dG = self._beam(self.theta)
-            # Linear amplitudes (a, d) per view by 2 x 2 normal equations.
-            B = np.stack([G, self.D], axis=2)                    # (K, N, 2)
-            BH = B.conj().transpose(0, 2, 1)
-            coef = np.linalg.solve(BH @ B, BH @ h[..., None])[..., 0]   # (K, 2)
-            model = (B @ coef[..., None])[..., 0]
-            if it == steps:
-                return model
-            r = h - model
-            J = -coef[:, 0:1, None] * np.stack(dG, axis=2)       # (K, N, 3)
-            JH = J.conj().transpose(0, 2, 1)
-            step = np.linalg.solve(np.real(JH @ J), np.real(JH @ r[..., None]))[..., 0]
-            self.theta = self.theta - step
-            self.theta[:, 2] = np.clip(self.theta[:, 2], 0.0, 2 * np.pi**2 / self.k)
-        return model  # pragma: no cover - the loop returns
+    def _fit(self, h: np.ndarray) -> np.ndarray:
+        """One Gauss-Newton step for all views at once; returns the fitted glare + direct.
+
+        Variable projection: the amplitudes (a, d) of each view are solved exactly
+        for the current beam, then the beam's (xc, yc, b) take one Gauss-Newton
+        step, and the model follows that step to first order (the step is small
+        when tracking, and the next frame starts from it).
+        """
+        G, *dG = self._beam(self.theta)
+        B = np.stack([G, self.D], axis=2)                                # (K, N, 2)
+        BH = B.conj().transpose(0, 2, 1)
+        coef = np.linalg.solve(BH @ B, BH @ h[..., None])[..., 0]       # (K, 2)
+        model = (B @ coef[..., None])[..., 0]
+        r = h - model
+        J = -coef[:, 0:1, None] * np.stack(dG, axis=2)                   # d r / d theta
+        JH = J.conj().transpose(0, 2, 1)
+        step = np.linalg.solve(np.real(JH @ J), np.real(JH @ r[..., None]))[..., 0]
+        theta = self.theta - step
+        theta[:, 2] = np.clip(theta[:, 2], 0.0, 2 * np.pi**2 / self.k)
+        step = self.theta - theta
+        self.theta = theta
+        return model + (J @ step[..., None].astype(J.dtype))[..., 0]
+
+    def _embed(self, P: np.ndarray) -> np.ndarray:
+        """Zero-pad spectra into the image grid, reusing one buffer (see migrate)."""
+        if getattr(self, "_buf", None) is None or self._buf.shape[0] != P.shape[0]:
+            self._buf = _zero_pad_spectrum(P, self.u)
+        else:
+            My, Mx = P.shape[-2:]
+            u = self.u
+            hy, hx = (My + 1) // 2, (Mx + 1) // 2
+            b = self._buf
+            b[:, :hy, :hx] = P[:, :hy, :hx]
+            b[:, :hy, u * Mx - Mx // 2:] = P[:, :hy, Mx - Mx // 2:]
+            b[:, u * My - My // 2:, :hx] = P[:, My - My // 2:, :hx]
+            b[:, u * My - My // 2:, u * Mx - Mx // 2:] = P[:, My - My // 2:, Mx - Mx // 2:]
+            if My % 2 == 0:
+                b[:, My // 2, :] = b[:, u * My - My // 2, :] = 0.5 * b[:, u * My - My // 2, :]
+            if Mx % 2 == 0:
+                b[:, :, Mx // 2] = b[:, :, u * Mx - Mx // 2] = 0.5 * b[:, :, u * Mx - Mx // 2]
+        return self._buf
 
     # ------------------------------------------------------------------- a frame
     def __call__(self, data: np.ndarray) -> Image:
@@ -162,11 +187,10 @@ class StreamImager:
         H = self.op.spectrum(flat.reshape(h.shape))
         P = H * self.uc
         if self.u > 1:
-            P = _zero_pad_spectrum(P, self.u) * (self.u * self.u)
-        g = sfft.ifft2(P, axes=(-2, -1), workers=-1, overwrite_x=True)
-        img = g[0] * self.phasors[0]
-        for gk, pk in zip(g[1:], self.phasors[1:], strict=True):
-            img += gk * pk
+            P = self._embed(P)
+        g = sfft.ifft2(P, axes=(-2, -1), workers=-1, overwrite_x=self.u == 1)
+        np.multiply(g, self.phasors, out=g)
+        img = g.sum(axis=0)
         img = np.roll(img, self.roll, axis=(0, 1))
         return Image(img, self.x, self.y, np.array([self.z]), self.frequency,
                      "stream:coherent", has_z_axis=False)
