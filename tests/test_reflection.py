@@ -163,3 +163,12 @@ def test_bad_input_is_refused_or_warned():
         warnings.simplefilter("always")
         hr.suppress_surface(noise, SAND, HORN, "gaussian", direct=False)
     assert any(issubclass(x.category, hr.FitWarning) for x in w)
+
+
+def test_mirror_image_outside_the_imaged_grid_is_refused():
+    # A horn 3 m to the side: its mirror image lies far outside the padded grid the
+    # hologram can be migrated onto; the fit would chase noise, so it is an error.
+    full, _ = _scene()
+    far = hr.PointSource((3.0, 0.0, -0.05))
+    with pytest.raises(ValueError, match="outside the imaged grid"):
+        hr.suppress_surface(full, SAND, far, "gaussian")
