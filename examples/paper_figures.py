@@ -114,19 +114,22 @@ def fig14_15(out: Path) -> dict:
            "glare-free": hr.migrate(clean, z_obj, medium=medium, upsample=8)}
     ref = np.abs(obj["glare-free"].data)
     glare_img = hr.migrate(full.with_data(full.data - clean.data), z_obj, medium=medium).data
-    for method, kw in (("cut", {"taper": False}), ("gaussian", {}),
-                       ("image_source", {"direct": False})):
+    for name, method, kw in (("cut", "cut", {"taper": False}), ("gaussian", "gaussian", {}),
+                             ("gaussian_mirror_window", "gaussian", {"fit_domain": "mirror"}),
+                             ("image_source", "image_source", {"direct": False})):
         cleaned, rep = hr.suppress_surface(full, medium, horn, method, **kw)
-        mirror[method] = hr.migrate(cleaned, z_m, upsample=8, fov="full")
-        obj[method] = hr.migrate(cleaned, z_obj, medium=medium, upsample=8)
+        mirror[name] = hr.migrate(cleaned, z_m, upsample=8, fov="full")
+        obj[name] = hr.migrate(cleaned, z_obj, medium=medium, upsample=8)
         left = hr.migrate(cleaned.with_data(cleaned.data - clean.data), z_obj,
                           medium=medium).data
-        res[method] = {
+        res[name] = {
             "glare_lowered_in_object_plane_db": float(
                 20 * np.log10(np.linalg.norm(glare_img) / np.linalg.norm(left))),
-            "object_peak_kept": float(np.abs(obj[method].data).ravel()[np.argmax(ref)]
+            # |image| at the object's brightest pixel over its glare-free value: for the
+            # cut, leftover glare, not the object, makes this exceed 1.
+            "object_peak_kept": float(np.abs(obj[name].data).ravel()[np.argmax(ref)]
                                       / ref.max()),
-            "shape_correlation": shape_correlation(obj[method], R),
+            "shape_correlation": shape_correlation(obj[name], R),
             "mirror_spot_suppression_db": rep.glare_suppression_db,
             "eps_estimate": None if rep.eps is None else [rep.eps.real, rep.eps.imag],
         }

@@ -164,3 +164,13 @@ def test_spectral_coverage_figure(tmp_path):
     p = np.linspace(-300, 300, 121)
     png = to_png(plot_spectrum(p, p, np.ones((121, 121)), wins, union=True))
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_more_bad_input():
+    with pytest.raises(ValueError, match="images must be a stack"):
+        hr.align_phases(np.zeros((0, 4, 4)))
+    buried = hr.PointSource((0.0, 0.0, 0.35))
+    with pytest.raises(ValueError, match="must lie above the ground surface"):
+        from holoradar.physics.incident import incident_on_plane
+
+        incident_on_plane(buried, K, SAND, np.zeros(2), np.zeros(2), 0.4)

@@ -247,7 +247,19 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     >>> rep.glare_suppression_db > 20
     True
     """
-    src = source if source is not None else hologram.source
+    src = source if source is not None else getattr(hologram, "source", None)
+    if src is None and method != "background":
+        raise ValueError("source must be given (the radiator as a PointSource), or carried "
+                         "by the hologram (Hologram(..., source=...))")
+    if fit_domain not in ("aperture", "mirror"):
+        raise ValueError(f"fit_domain must be 'aperture' or 'mirror', got {fit_domain!r}")
+    if cut_radius is not None and not (np.isfinite(cut_radius) and cut_radius > 0):
+        raise ValueError(f"cut_radius must be a radius > 0 in metres, got {cut_radius!r}")
+    if initial is not None:
+        need = {"gaussian": {"x", "y", "b"}, "image_source": {"eps"}}.get(method, set())
+        if not isinstance(initial, dict) or not need <= set(initial):
+            raise ValueError(f"initial must be the parameters dict of a previous {method!r} "
+                             f"report (keys {sorted(need)}), got {initial!r}")
     z_m = _check(hologram, medium, src, method)
     data = hologram.data
     if method == "background":
@@ -331,9 +343,22 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         direct_removed_db=None if D is None else _db(float(np.sum(np.abs(direct_part) ** 2)),
                                                      left),
         direct_amplitude=dcoef, converged=converged, parameters=params)
-    ref = reference_amplitude if reference_amplitude is not None else src.amplitude
-    if method == "gaussian" and ref:
-        V, eps = _eps_from_gaussian(report_kw["amplitude"], params["b"], complex(ref), src, k)
+    if method == "gaussian":
+        # The radiator's amplitude: given, or the direct wave's when one was found (it
+        # carries at least 1% of the hologram's energy), else the source's own.
+        ref = reference_amplitude
+        if ref is None and D is not None and dcoef is not None and (
+                np.sum(np.abs(direct_part) ** 2) > 0.01 * np.sum(np.abs(h) ** 2)):
+            ref = dcoef
+        if ref is None:
+            ref = src.amplitude
+        V, eps = _eps_from_gaussian(report_kw["amplitude"], params["b"], complex(ref), src,
+                                    hologram, z_m, k)
+        if not np.isfinite(eps.real):
+            warnings.warn("suppress_surface: the glare is stronger than the reference "
+                          "amplitude allows (|V| >= 1): give reference_amplitude (a "
+                          "calibration of the radiator) to estimate eps", FitWarning,
+                          stacklevel=2)
         report_kw.update(reflection_coefficient=V, eps=eps)
     if not converged:
         warnings.warn(f"suppress_surface: the {method} fit did not converge; the glare may "
@@ -423,20 +448,27 @@ def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
     What the glare model leaves is mostly the object's own field and the noise:
     smooth over the aperture, not white, so ``s^2 (J^T J)^-1`` would be far too
     optimistic. The sandwich (Huber-White / Newey-West) estimator
-    ``B^-1 Re(J^H S J) B^-1``, ``B = Re(J^H J)``, uses the residual's covariance S,
-    taken stationary and estimated from its autocorrelation over the aperture.
+    ``B^-1 M B^-1``, ``B = Re(J^H J)``, ``M = Cov(Re(J^H r)) = Re(J^H S J)/2`` for a
+    circular complex residual, uses the residual's covariance S, taken stationary
+    and estimated from its autocorrelation over the aperture with a Bartlett lag
+    window reaching half the aperture (Newey & West 1987): the raw all-lag
+    estimate would give ``J^H S J ~ |J^H r|^2``, which vanishes at the fit.
     """
     n = fun.size // 2
     r = (fun[:n] + 1j * fun[n:]).reshape(shape)
     J = (jac[:n] + 1j * jac[n:]).reshape((*shape, -1))
     ny, nx = shape
     s = (2 * ny, 2 * nx)
-    R = sfft.fft2(r, s=s)
-    acf_spec = np.abs(R) ** 2 / r.size  # spectrum of the (biased) autocorrelation
+    acf = sfft.ifft2(np.abs(sfft.fft2(r, s=s)) ** 2) / r.size  # lags in FFT order
+    ly, lx = max(ny / 2, 2.0), max(nx / 2, 2.0)
+    ty = np.abs(sfft.fftfreq(s[0], 1.0 / s[0]))
+    tx = np.abs(sfft.fftfreq(s[1], 1.0 / s[1]))
+    bartlett = np.outer(np.clip(1 - ty / ly, 0, None), np.clip(1 - tx / lx, 0, None))
+    acf_spec = sfft.fft2(acf * bartlett)
     SJ = sfft.ifft2(sfft.fft2(J, s=s, axes=(0, 1)) * acf_spec[..., None], axes=(0, 1))
     SJ = SJ[:ny, :nx]
     Jf = J.reshape(-1, J.shape[-1])
-    meat = np.real(Jf.conj().T @ SJ.reshape(-1, J.shape[-1]))
+    meat = 0.5 * np.real(Jf.conj().T @ SJ.reshape(-1, J.shape[-1]))
     bread = np.real(Jf.conj().T @ Jf)
     try:
         binv = np.linalg.inv(bread)
@@ -497,17 +529,22 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
 
 
 def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
-                       k: float) -> tuple[complex, complex]:
+                       hologram: Hologram, z_m: float, k: float) -> tuple[complex, complex]:
     """V and eps from the mirror spot's strength, near-normal incidence.
 
     The fitted beam ``a*exp(ik Rc)/Rc``, ``Rc ~ s - i*b`` on its axis, is the mirror
     image's spherical wave ``V * ref * pattern * exp(iks)/s`` for a source of
-    amplitude ``ref``: V = a*exp(k*b) / (ref * pattern(straight down)), to first
-    order in b/s. Its phase is traded against the fitted range of the beam (a
+    amplitude ``ref``: V = a*exp(k*b) / (ref * pattern), to first order in b/s,
+    the pattern taken along the specular ray from the radiator to the aperture's
+    centre. Its phase is traded against the fitted range of the beam (a
     millimetre is 0.2 rad), so only |V| is used: for a ground denser than air
     V = -|V| and n = (1 + |V|)/(1 - |V|), real (loss is not seen this way).
     """
-    pat = src.pattern(np.array([[0.0, 0.0, 1.0]]))[0] if src.has_pattern else 1.0
+    # The ray leaves the radiator towards the aperture centre's mirror point, downwards.
+    d = np.array([np.mean(hologram.x) - src.position[0], np.mean(hologram.y) - src.position[1],
+                  z_m - src.position[2]])
+    d /= np.linalg.norm(d)
+    pat = src.pattern(d[None, :])[0] if src.has_pattern else 1.0
     if pat == 0:
         return complex(np.nan), complex(np.nan)
     V = -abs(a * np.exp(k * b) / (ref * pat))
@@ -521,11 +558,15 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
                           direct: bool = True) -> tuple[complex, tuple[float, float]]:
     """Permittivity of the ground's top layer from the glare, with its 1-sigma uncertainty.
 
-    Fits the exact reflected field of the radiator (``method="image_source"``):
-    the angle-dependent reflection coefficient across the aperture fixes eps
-    even though the radiator's amplitude and phase are fitted too (the direct
-    wave, when present, is fitted alongside). ``medium`` supplies the geometry
-    and the starting value.
+    Fits the exact reflected field of the radiator (``method="image_source"``).
+    The glare's strength against the radiator's fixes |V| and hence eps: the
+    radiator's amplitude is the direct wave's, fitted jointly (``direct=True``,
+    the direct-path reference; it must be in the data), or ``source.amplitude``
+    (``direct=False``, a calibration). ``medium`` supplies the geometry and the
+    starting value. The 1-sigma covers receiver noise and diffuse clutter (a
+    sandwich estimate); it does not cover model error (a vector source seen as
+    a scalar one) nor the bias of a single strong buried object, at most
+    ``4 n |V| e / (1 + V)^2`` for an object ``e`` times weaker than the glare.
 
     Examples
     --------
@@ -537,5 +578,21 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     >>> round(eps.real, 2)
     4.0
     """
+    src = source if source is not None else getattr(hologram, "source", None)
+    if direct and isinstance(src, PointSource):
+        pts = np.c_[np.meshgrid(hologram.x, hologram.y)[0].ravel(),
+                    np.meshgrid(hologram.x, hologram.y)[1].ravel(), np.zeros(hologram.x.size
+                                                                         * hologram.y.size)]
+        D = free_space_green(hologram.k, src.position, pts)
+        if src.has_pattern:
+            r = pts - src.position
+            D = D * src.pattern(r / np.linalg.norm(r, axis=1, keepdims=True))
+        h = hologram.data.ravel()
+        share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)
+        if share < 0.01:
+            raise ValueError("direct=True takes the radiator's direct wave as the amplitude "
+                             "reference, but the hologram holds almost none of it (the direct "
+                             "wave explains <1% of it): pass direct=False with a calibrated "
+                             "source amplitude")
     _, rep = suppress_surface(hologram, medium, source, "image_source", direct=direct)
     return rep.eps, rep.eps_std

@@ -16,6 +16,7 @@ direct waves) and then, per frame, does only:
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -29,7 +30,7 @@ from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
 from ..physics.sources import PointSource
 from .migrate import _zero_pad_spectrum
-from .reflection import suppress_surface
+from .reflection import FitWarning, suppress_surface
 from .synthesis import _check_views
 
 __all__ = ["StreamImager"]
@@ -71,6 +72,11 @@ class StreamImager:
     def __init__(self, views: Sequence[Hologram], z: float, medium: Medium, *,
                  upsample: int = 4, suppress: bool = True) -> None:
         views = _check_views(views)
+        if np.ndim(z) != 0:
+            raise ValueError(f"z must be one range in metres (a frame images one plane), got "
+                             f"{z!r}")
+        if not isinstance(upsample, int | np.integer) or upsample < 1:
+            raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
         h0 = views[0]
         self.k = h0.k
         self.shape = h0.data.shape[-2:]
@@ -146,6 +152,13 @@ class StreamImager:
         coef = np.linalg.solve(BH @ B, BH @ h[..., None])[..., 0]       # (K, 2)
         model = (B @ coef[..., None])[..., 0]
         r = h - model
+        explained = 1 - np.sum(np.abs(r) ** 2, axis=1) / np.maximum(
+            np.sum(np.abs(h) ** 2, axis=1), 1e-300)
+        if np.any(explained < 0.5):
+            warnings.warn("StreamImager: in some views the glare model explains less than "
+                          "half of the frame; the glare may have changed more than one step "
+                          "can follow (re-create the imager from this frame)", FitWarning,
+                          stacklevel=3)
         J = -coef[:, 0:1, None] * np.stack(dG, axis=2)                   # d r / d theta
         JH = J.conj().transpose(0, 2, 1)
         step = np.linalg.solve(np.real(JH @ J), np.real(JH @ r[..., None]))[..., 0]
@@ -182,7 +195,9 @@ class StreamImager:
             raise ValueError(f"data must have shape {(self.phasors.shape[0], *self.shape)}, "
                              f"got {h.shape}")
         flat = h.reshape(h.shape[0], -1).astype(complex, copy=False)
-        if self.suppress:
+        if not np.all(np.isfinite(flat)):
+            raise ValueError("data must be finite: the frame contains NaN or inf values")
+        if self.suppress and np.any(flat):
             flat = flat - self._fit(flat)
         H = self.op.spectrum(flat.reshape(h.shape))
         P = H * self.uc

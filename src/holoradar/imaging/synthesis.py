@@ -92,6 +92,9 @@ def align_phases(images: np.ndarray, *, passes: int = 3) -> tuple[np.ndarray, np
     array([ 0.,  1., -2.])
     """
     g = np.asarray(images)
+    if g.ndim < 2 or g.shape[0] == 0 or g[0].size == 0:
+        raise ValueError(f"images must be a stack (K, ...) of K >= 1 complex images, got shape "
+                         f"{g.shape}")
     flat = g.reshape(g.shape[0], -1)
     ref = flat[int(np.argmax(np.sum(np.abs(flat) ** 2, axis=1)))]
     phases = np.angle(flat @ ref.conj())  # arg <ref, g_k>

@@ -55,6 +55,7 @@ def incident_on_plane(source: object, k: float, medium: Medium, x: np.ndarray, y
     if not isinstance(source, PointSource):
         raise ValueError(f"source must be a PlaneWave, PointSource or GaussianBeam, got "
                          f"{type(source).__name__}")
+    source._check_air(medium)  # a radiator below the surface is refused, as elsewhere
     src = source.position
     rho = np.hypot(X - src[0], Y - src[1])
     n = abs(medium.n(medium.region_of(z)))
