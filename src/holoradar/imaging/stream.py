@@ -55,7 +55,10 @@ class StreamImager:
         :func:`~holoradar.physics.propagation.padded_shape`): 128 pixels a side
         for the paper's 16 x 16 array at 0.4 m and ``upsample=4``.
     suppress : bool
-        Remove the glare and the direct wave of each view (default True).
+        Remove the glare and the direct wave of each view (default True). The
+        mirror planes follow from ``medium``'s surface and the radiators'
+        positions, fixed for the imager's life: a moved surface or horn needs a
+        new imager.
 
     Examples
     --------

@@ -331,25 +331,30 @@ class Medium:
                 r = r_m
         return r
 
+    def crossings(self, z: float) -> list[tuple[int, float]]:
+        """``(region, thickness)`` of every region crossed from the aperture plane to ``z``.
+
+        Examples
+        --------
+        >>> [(m, round(h, 6)) for m, h in Medium.half_space(0.3, 2.5).crossings(0.42)]
+        [(0, 0.3), (1, 0.12)]
+        """
+        j = self.region_of(z)
+        out = []
+        for m in range(j + 1):
+            top = self.top_of(m)
+            bottom = z if m == j else self.z_interfaces[m]
+            if bottom > top:
+                out.append((m, bottom - top))
+        return out
+
     def apparent_distance(self, z: float) -> float:
         """Paraxial apparent range ``L = sum of layer thicknesses / Re(n)`` down to ``z``.
 
         For a half-space: ``L = z0 + (z - z0)/n`` (PHYSICS.md section 6).
         """
-        j = self.region_of(z)
-        L = 0.0
-        for m in range(j + 1):
-            top = self.top_of(m)
-            bottom = z if m == j else self.z_interfaces[m]
-            L += (bottom - top) / self.n(m).real
-        return float(L)
+        return float(sum(h / self.n(m).real for m, h in self.crossings(z)))
 
     def optical_path(self, z: float) -> complex:
         """Normal-incidence optical path ``sum n_j h_j`` from the aperture to ``z`` (metres)."""
-        j = self.region_of(z)
-        s = 0j
-        for m in range(j + 1):
-            top = self.top_of(m)
-            bottom = z if m == j else self.z_interfaces[m]
-            s += self.n(m) * (bottom - top)
-        return s
+        return complex(sum(self.n(m) * h for m, h in self.crossings(z)))

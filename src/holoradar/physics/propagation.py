@@ -83,15 +83,9 @@ def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np
     """
     kappa2 = np.asarray(kappa2, dtype=float)
     travel = np.zeros(np.shape(kappa2))
-    j = medium.region_of(z)
-    for m in range(j + 1):
-        top = medium.top_of(m)
-        bottom = z if m == j else medium.z_interfaces[m]
-        if bottom <= top:
-            continue
+    for m, h in medium.crossings(z):
         kz = medium.kz(k, kappa2, m).real
-        with np.errstate(divide="ignore"):
-            travel = travel + np.where(kz > 0, (bottom - top) / np.where(kz > 0, kz, 1), np.inf)
+        travel = travel + np.where(kz > 0, h / np.where(kz > 0, kz, 1), np.inf)
     return travel
 
 
@@ -105,14 +99,9 @@ def loss_exponent(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.
     kappa2 = np.asarray(kappa2, dtype=float)
     total = np.zeros(np.shape(kappa2))
     propagating = np.ones(np.shape(kappa2), dtype=bool)
-    j = medium.region_of(z)
-    for m in range(j + 1):
-        top = medium.top_of(m)
-        bottom = z if m == j else medium.z_interfaces[m]
-        if bottom <= top:
-            continue
+    for m, h in medium.crossings(z):
         propagating &= kappa2 < k * k * complex(medium.eps[m]).real
-        total += medium.kz(k, kappa2, m).imag * (bottom - top)
+        total += medium.kz(k, kappa2, m).imag * h
     return np.where(propagating, total, 0.0)
 
 
