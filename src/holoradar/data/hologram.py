@@ -100,6 +100,12 @@ class Hologram:
         dx, dy = self.pitch
         return self.x.size * dx, self.y.size * dy
 
+    @property
+    def points(self) -> np.ndarray:
+        """Element positions (N, 3) on the plane z = 0, row-major over (y, x) like ``data``."""
+        X, Y = np.meshgrid(self.x, self.y)
+        return np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+
     def with_data(self, data: Any) -> Hologram:
         """A copy with new ``data`` of the same trailing shape (coordinates kept).
 

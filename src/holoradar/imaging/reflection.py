@@ -46,7 +46,6 @@ from scipy.optimize import least_squares
 
 from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram
-from ..physics.green import free_space_green
 from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
 from ..physics.sources import PointSource
@@ -279,20 +278,14 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     if data.ndim != 2:
         raise ValueError(f"suppress_surface takes one view (ny, nx), got shape {data.shape}")
     k = hologram.k
-    pts = np.c_[np.meshgrid(hologram.x, hologram.y)[0].ravel(),
-                np.meshgrid(hologram.x, hologram.y)[1].ravel(), np.zeros(data.size)]
+    pts = hologram.points
     op = _mirror_operator(hologram, z_m)
     A = hologram.aperture_size
     cell = lateral_resolution(hologram.wavelength, z_m, min(A))
     predicted = np.array([src.position[0], src.position[1]])
     E_before = _mirror_image(op, data)
     xs, ys, peak_before = _find_spot(hologram, op, E_before, predicted, 3 * cell)
-    D = None
-    if direct:
-        D = free_space_green(k, src.position, pts)
-        if src.has_pattern:
-            d = pts - src.position
-            D = D * src.pattern(d / np.linalg.norm(d, axis=1, keepdims=True))
+    D = _direct_wave(src, k, pts) if direct else None
     h = data.ravel()
     report_kw: dict[str, Any] = {"mirror_plane": z_m}
     if method == "cut":
@@ -365,6 +358,12 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                       "be only partly removed", FitWarning, stacklevel=2)
     return hologram.with_data(cleaned.reshape(data.shape)), SuppressionReport(method,
                                                                                **report_kw)
+
+
+def _direct_wave(src: PointSource, k: float, pts: np.ndarray) -> np.ndarray:
+    """The radiator's own wave at air points, for unit amplitude: ``exp(ikR)/R`` times its
+    pattern along the straight ray (the shape the direct-wave fit scales)."""
+    return replace(src, amplitude=1.0).field(k, Medium.free_space(), pts)
 
 
 def _joint_direct(h: np.ndarray, glare: np.ndarray, D: np.ndarray | None
@@ -580,13 +579,7 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     """
     src = source if source is not None else getattr(hologram, "source", None)
     if direct and isinstance(src, PointSource):
-        pts = np.c_[np.meshgrid(hologram.x, hologram.y)[0].ravel(),
-                    np.meshgrid(hologram.x, hologram.y)[1].ravel(), np.zeros(hologram.x.size
-                                                                         * hologram.y.size)]
-        D = free_space_green(hologram.k, src.position, pts)
-        if src.has_pattern:
-            r = pts - src.position
-            D = D * src.pattern(r / np.linalg.norm(r, axis=1, keepdims=True))
+        D = _direct_wave(src, hologram.k, hologram.points)
         h = hologram.data.ravel()
         share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)
         if share < 0.01:

@@ -24,13 +24,12 @@ import scipy.fft as sfft
 
 from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram, Image
-from ..physics.green import free_space_green
 from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
 from ..physics.sources import PointSource
 from .migrate import _zero_pad_spectrum
-from .reflection import FitWarning, suppress_surface
+from .reflection import FitWarning, _direct_wave, suppress_surface
 from .synthesis import _check_views
 
 __all__ = ["StreamImager"]
@@ -107,8 +106,7 @@ class StreamImager:
         # The inverse FFT onto the u-times finer grid normalises by u^2 too much: the
         # factor rides on the phasors, saving a pass over the K images every frame.
         self.phasors = np.stack(ph).astype(self.uc.dtype) * (self.u * self.u)
-        X, Y = np.meshgrid(h0.x, h0.y)
-        self.pts = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+        self.pts = h0.points
         if suppress:
             self._init_tracking(views, med, dx * h0.x.size)
 
@@ -120,11 +118,7 @@ class StreamImager:
                 raise ValueError("suppress=True needs each view's source to be a PointSource")
             _, rep = suppress_surface(v, medium, v.source, "gaussian")
             theta.append([rep.parameters["x"], rep.parameters["y"], rep.parameters["b"]])
-            d = free_space_green(self.k, v.source.position, self.pts)
-            if v.source.has_pattern:
-                r = self.pts - v.source.position
-                d = d * v.source.pattern(r / np.linalg.norm(r, axis=1, keepdims=True))
-            D.append(d)
+            D.append(_direct_wave(v.source, self.k, self.pts))
         self.D = np.stack(D)                                   # (K, N)
         self.theta = np.array(theta, float)                    # (K, 3): xc, yc, b
         self.zm = np.array([2 * medium.z_interfaces[0] - v.source.position[2] for v in views])
