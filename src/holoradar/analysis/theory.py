@@ -15,6 +15,7 @@ from scipy.special import fresnel
 from .._validate import as_real, check_frequency
 from ..data.hologram import C0
 from ..physics.medium import _check_eps
+from ..physics.medium import fresnel as _interface_fresnel
 
 __all__ = [
     "SpectralWindow",
@@ -263,10 +264,13 @@ def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> di
     -------
     dict
         ``r_te, t_te, r_tm, t_tm``: TE (E parallel to the interface) and TM, both
-        signed as the tangential electric field (``r_tm`` is the negative of the
-        magnetic-field r_p; ``t_tm`` is the ratio of electric-field amplitudes).
-        At normal incidence ``r_te = (n1 - n2)/(n1 + n2)``, ``t = 2 n1/(n1 + n2)``:
-        from air into ground V = (1 - n)/(1 + n), W = 2/(1 + n).
+        for the electric field TANGENTIAL to the interface, the scalar field of
+        :class:`~holoradar.Medium` (these are its own coefficients,
+        :func:`holoradar.physics.medium.fresnel`). So ``t = 1 + r`` for both;
+        ``r_tm`` is the negative of the magnetic-field r_p, and ``t_tm`` is the
+        total-field ``t_p`` times ``cos(theta2)/cos(theta1)``. At normal incidence
+        ``r = (n1 - n2)/(n1 + n2)``, ``t = 2 n1/(n1 + n2)``: from air into ground
+        V = (1 - n)/(1 + n), W = 2/(1 + n).
 
     Examples
     --------
@@ -274,20 +278,20 @@ def fresnel_coefficients(eps1: complex, eps2: complex, theta: float = 0.0) -> di
     >>> complex(c["r_te"]), complex(c["t_te"])
     ((-0.5+0j), (0.5+0j))
     """
-    n1, n2 = refractive_index(eps1), refractive_index(eps2)
+    n1 = refractive_index(eps1)
+    refractive_index(eps2)
     theta = as_real(theta, "theta")
     if not 0 <= theta < np.pi / 2:
         raise ValueError(f"theta must be an angle of incidence in [0, pi/2) radians, got {theta}")
-    kx = n1 * np.sin(theta)
-    c1 = np.sqrt(n1 * n1 - kx * kx + 0j)
-    c2 = np.sqrt(n2 * n2 - kx * kx + 0j)
-    c2 = -c2 if c2.imag < 0 else c2
-    return {
-        "r_te": (c1 - c2) / (c1 + c2),
-        "t_te": 2 * c1 / (c1 + c2),
-        "r_tm": (eps1 * c2 - eps2 * c1) / (eps2 * c1 + eps1 * c2),
-        "t_tm": 2 * n1 * n2 * c1 / (eps2 * c1 + eps1 * c2),
-    }
+    # kz / k on either side (k cancels in the coefficients).
+    kap2 = (n1 * np.sin(theta)) ** 2
+    c1 = np.sqrt(complex(eps1) - kap2)
+    c2 = np.sqrt(complex(eps2) - kap2)
+    c1, c2 = (-c if c.imag < 0 else c for c in (c1, c2))
+    r_te, t_te = _interface_fresnel(c1, c2, complex(eps1), complex(eps2), "TE")
+    r_tm, t_tm = _interface_fresnel(c1, c2, complex(eps1), complex(eps2), "TM")
+    return {"r_te": complex(r_te), "t_te": complex(t_te), "r_tm": complex(r_tm),
+            "t_tm": complex(t_tm)}
 
 
 def attenuation(eps: complex, frequency: float, distance: float) -> dict[str, float]:

@@ -10,11 +10,13 @@ Region 0 (``0 <= z < z_interfaces[0]``) is air and holds the aperture; region j
 lies between ``z_interfaces[j-1]`` and ``z_interfaces[j]`` and the last one extends
 to infinity. A point exactly on an interface belongs to the deeper region.
 
-Plane-wave transmission across each interface uses the Fresnel coefficient of the
-chosen polarisation (TE by default, i.e. the electric field parallel to the
-interface, the scalar model of the paper); multiple reflections inside a layer
-are neglected in transmission (first-order, as in the paper's Eqs. 8-11), while
-the specular reflection of the whole stack (:meth:`Medium.reflection`) sums them.
+The scalar field is the electric field tangential to the interfaces: TE (the
+default; E parallel to the interfaces, the paper's scalar model) or TM (the
+tangential component of an E field in the plane of incidence). Plane waves cross
+the stack exactly: every component is carried with the Fresnel coefficients of
+every interface and all the multiple reflections inside the layers (Parratt's
+recursion for the reflection, generalised transmission coefficients for the
+transmission), in both directions.
 """
 
 from __future__ import annotations
@@ -22,13 +24,13 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import numpy as np
 
 from .._validate import check_frequency
 
-__all__ = ["Medium", "permittivity"]
+__all__ = ["Medium", "fresnel", "permittivity"]
 
 Polarization = Literal["TE", "TM"]
 
@@ -67,6 +69,54 @@ def permittivity(eps_real: float, tan_delta: float = 0.0, *, sigma: float | None
         f = check_frequency(frequency if frequency is not None else -1.0, "frequency")
         eps += 1j * sigma / (2 * np.pi * f * 8.8541878128e-12)
     return eps
+
+
+def fresnel(kz1: np.ndarray, kz2: np.ndarray, eps1: complex, eps2: complex,
+            polarization: Polarization = "TE") -> tuple[np.ndarray, np.ndarray]:
+    """Fresnel reflection and transmission of the tangential electric field, from 1 into 2.
+
+    Parameters
+    ----------
+    kz1, kz2 : ndarray
+        Vertical wavenumbers ``sqrt(k^2*eps_j - kappa^2)`` (``Im >= 0``) on either
+        side, rad/m.
+    eps1, eps2 : complex
+        Relative permittivities.
+    polarization : {"TE", "TM"}
+
+    Returns
+    -------
+    r, t : ndarray
+        TE: ``r = (kz1 - kz2)/(kz1 + kz2)``. TM, signed as the tangential electric
+        field (the negative of the magnetic-field ``r_p``):
+        ``r = (eps1 kz2 - eps2 kz1)/(eps2 kz1 + eps1 kz2)``. For both, the tangential
+        field is continuous, so ``t = 1 + r``; at normal incidence
+        ``r = (n1 - n2)/(n1 + n2)`` and ``t = 2 n1/(n1 + n2)``. Power balance
+        across a lossless interface: ``|r|^2 + Y2/Y1 |t|^2 = 1`` with the admittance
+        ``Y = kz`` (TE) or ``Y = eps/kz`` (TM). Where both kz vanish (grazing
+        incidence on an index-matched interface) there is no interface: ``r = 0``.
+
+    Examples
+    --------
+    >>> r, t = fresnel(np.array(1.0), np.array(2.0), 1.0, 4.0)
+    >>> np.round([r, t], 4)
+    array([-0.3333+0.j,  0.6667+0.j])
+    """
+    kz1 = np.asarray(kz1, dtype=complex)
+    kz2 = np.asarray(kz2, dtype=complex)
+    if polarization == "TE":
+        num, den = kz1 - kz2, kz1 + kz2
+    else:
+        num, den = eps1 * kz2 - eps2 * kz1, eps2 * kz1 + eps1 * kz2
+    r = np.divide(num, den, out=np.zeros(np.broadcast(num, den).shape, complex),
+                  where=den != 0)
+    return r, 1 + r
+
+
+class _Stack(NamedTuple):
+    kzs: list[np.ndarray]                            # kz of every region
+    rt: list[tuple[np.ndarray, np.ndarray]]          # (r, t) down across interface j
+    rho: list[np.ndarray]                            # reflection below interface j
 
 
 def _check_eps(eps: complex, name: str) -> complex:
@@ -234,40 +284,125 @@ class Medium:
     # ------------------------------------------------------------ interface laws
     def transmission(self, kz_from: np.ndarray, kz_to: np.ndarray, eps_from: complex,
                      eps_to: complex) -> np.ndarray:
-        """Fresnel transmission of the field amplitude across one interface.
+        """Fresnel transmission of the tangential electric field across one interface.
 
-        TE: ``2 kz1 / (kz1 + kz2)``; TM (electric-field amplitude):
-        ``2 n1 n2 kz1 / (eps2 kz1 + eps1 kz2)``. Both give ``2 n1/(n1 + n2)`` at
-        normal incidence.
+        ``1 + r`` for either polarisation (the tangential field is continuous):
+        TE ``2 kz1 / (kz1 + kz2)``, TM ``2 eps1 kz2 / (eps2 kz1 + eps1 kz2)``; both
+        ``2 n1/(n1 + n2)`` at normal incidence. See :func:`fresnel`.
         """
-        if self.polarization == "TE":
-            return 2 * kz_from / (kz_from + kz_to)
-        n1, n2 = np.sqrt(complex(eps_from)), np.sqrt(complex(eps_to))
-        return 2 * n1 * n2 * kz_from / (eps_to * kz_from + eps_from * kz_to)
+        return fresnel(kz_from, kz_to, eps_from, eps_to, self.polarization)[1]
 
     def fresnel_reflection(self, kz_from: np.ndarray, kz_to: np.ndarray, eps_from: complex,
                            eps_to: complex) -> np.ndarray:
-        """Fresnel reflection of the field amplitude at one interface.
+        """Fresnel reflection of the tangential electric field at one interface.
 
-        TE: ``(kz1 - kz2)/(kz1 + kz2)``; TM: ``(eps1 kz2 - eps2 kz1)/(eps2 kz1 + eps1 kz2)``,
-        signed as the tangential electric field (the negative of the usual
-        magnetic-field r_p), so that both give ``(n1 - n2)/(n1 + n2)`` at normal
-        incidence, as the scalar field of this model requires.
+        TE ``(kz1 - kz2)/(kz1 + kz2)``; TM ``(eps1 kz2 - eps2 kz1)/(eps2 kz1 + eps1 kz2)``
+        (the negative of the usual magnetic-field r_p); both ``(n1 - n2)/(n1 + n2)``
+        at normal incidence. See :func:`fresnel`.
         """
-        if self.polarization == "TE":
-            return (kz_from - kz_to) / (kz_from + kz_to)
-        return (eps_from * kz_to - eps_to * kz_from) / (eps_to * kz_from + eps_from * kz_to)
+        return fresnel(kz_from, kz_to, eps_from, eps_to, self.polarization)[0]
 
     # ------------------------------------------------------------ stack transfer
+    def _interfaces(self, k: float, kappa2: np.ndarray) -> _Stack:
+        """Vertical wavenumbers, local coefficients and Parratt ratios of the stack."""
+        kzs = [self.kz(k, kappa2, m) for m in range(self.n_regions)]
+        rt = [fresnel(kzs[j], kzs[j + 1], self.eps[j], self.eps[j + 1], self.polarization)
+              for j in range(self.n_regions - 1)]
+        # rho[j]: up/down amplitude ratio just above interface j (the reflection of
+        # everything below it), by Parratt's recursion from the bottom half-space up;
+        # only exp(2i kz h) with Im(kz) >= 0 appears, so thick lossy layers and
+        # evanescent waves cannot overflow.
+        rho: list[np.ndarray] = [np.zeros(np.shape(kappa2), complex)] * (self.n_regions - 1)
+        gamma = np.zeros(np.shape(kappa2), complex)  # ratio at the top of region j + 1
+        for j in range(self.n_regions - 2, -1, -1):
+            r = rt[j][0]
+            rho[j] = (r + gamma) / (1 + r * gamma)
+            if j >= 1:
+                gamma = rho[j] * np.exp(2j * kzs[j] * self._thickness(j))
+        return _Stack(kzs, rt, rho)
+
+    def _thickness(self, region: int) -> float:
+        return self.z_interfaces[region] - self.top_of(region)
+
+    def _down_into(self, st: _Stack, region: int) -> np.ndarray:
+        """Down-going amplitude at the top of ``region`` for amplitude 1 down-going in the
+        air at the surface, with every multiple reflection (the generalised transmission)."""
+        amp = np.ones(np.shape(st.kzs[0]), complex)
+        for j in range(region):
+            if j >= 1:
+                amp = amp * np.exp(1j * st.kzs[j] * self._thickness(j))
+            below = (st.rho[j + 1] * np.exp(2j * st.kzs[j + 1] * self._thickness(j + 1))
+                     if j + 1 < self.n_regions - 1 else 0.0)
+            r, t = st.rt[j]
+            amp = amp * t / (1 + r * below)
+        return amp
+
+    def _field_in(self, st: _Stack, region: int, z: float) -> np.ndarray:
+        """Total field at range ``z`` inside ``region`` for amplitude 1 down-going at the
+        surface: the down-going wave plus its reflection from the layers below."""
+        top = self.top_of(region)
+        field = np.exp(1j * st.kzs[region] * (z - top))
+        if region < self.n_regions - 1:
+            bottom = self.z_interfaces[region]
+            field = field + st.rho[region] * np.exp(1j * st.kzs[region] * (2 * bottom - top - z))
+        return self._down_into(st, region) * field
+
+    def _up_from(self, st: _Stack, region: int, z: float) -> np.ndarray:
+        """Up-going amplitude in the air at the surface radiated by a source at range ``z``
+        in ``region`` emitting amplitude 1 both up and down (a point source's plane waves).
+
+        In the source's layer the waves bounce between the stack above (generalised
+        reflection ``R_up``) and the one below (``rho``); the emerging wave then crosses
+        the layers above with their own multiple reflections.
+        """
+        kz = st.kzs[region]
+        top = self.top_of(region)
+        d1 = z - top
+        # Generalised reflection (looking up) and transmission (to the air) of the stack
+        # above each region, built from the surface down.
+        R_up = np.zeros(np.shape(kz), complex)
+        T_up = np.ones(np.shape(kz), complex)
+        for m in range(1, region + 1):
+            r_m, t_m = fresnel(st.kzs[m], st.kzs[m - 1], self.eps[m], self.eps[m - 1],
+                               self.polarization)  # from region m up into m - 1
+            if m == 1:
+                R_up, T_up = r_m, t_m
+                continue
+            ph = np.exp(1j * st.kzs[m - 1] * self._thickness(m - 1))
+            r_dn, t_dn = st.rt[m - 1]  # from m - 1 down into m: r_dn = -r_m
+            den = 1 - R_up * r_dn * ph * ph
+            T_up = T_up * t_m * ph / den
+            R_up = r_m + t_dn * t_m * R_up * ph * ph / den
+        u = np.ones(np.shape(kz), complex)
+        if region < self.n_regions - 1:
+            d2 = self.z_interfaces[region] - z
+            e1, e2 = np.exp(2j * kz * d1), np.exp(2j * kz * d2)
+            u = (1 + st.rho[region] * e2) / (1 - R_up * st.rho[region] * e1 * e2)
+        return u * np.exp(1j * kz * d1) * T_up
+
     def vertical_transfer(self, k: float, kappa2: np.ndarray, z_from: float,
                           z_to: float) -> np.ndarray:
-        """Plane-wave transfer of each angular component from range ``z_from`` to ``z_to``.
+        """Exact plane-wave transfer of each angular component from range ``z_from`` to ``z_to``.
 
-        A component of amplitude 1 at ``z_from`` arrives at ``z_to`` with this factor:
-        ``exp(i*kz_m*h_m)`` over the thickness ``h_m`` crossed in every region m,
-        times the Fresnel transmission of every interface crossed, in the direction
-        of travel (down when ``z_to > z_from``, up otherwise). In free space it is
-        ``exp(i*kz*|z_to - z_from|)``. Evanescent components decay.
+        One end must lie in the air that holds the aperture (region 0).
+
+        * Down (``z_from`` in the air, ``z_to >= z_from``): the field at ``z_to`` of a
+          component of amplitude 1 travelling down at ``z_from``. In the ground it is
+          the wave transmitted through every interface above ``z_to`` with all the
+          multiple reflections inside the layers, plus its reflection from the
+          layers below ``z_to`` (the total field there); in the air it is the direct
+          wave ``exp(i*kz0*(z_to - z_from))`` (the ground's reflection is
+          :meth:`reflection`).
+        * Up (``z_to`` in the air, ``z_from >= z_to``): the up-going field at ``z_to``
+          radiated by a source at ``z_from`` that emits amplitude 1 both up and down,
+          as each plane wave of a point source does (Weyl's expansion). Its
+          down-going half returns from the layers below, and the waves reverberate
+          in every layer, all summed exactly. By reciprocity it equals the down
+          transfer times ``kz_s/kz_0`` (TE) or ``eps_s kz_0/(eps_0 kz_s)`` (TM).
+
+        In free space it is ``exp(i*kz*|z_to - z_from|)``. Evanescent components
+        decay; the recursion involves only decaying exponentials, so it is stable
+        for thick lossy layers.
 
         Parameters
         ----------
@@ -278,6 +413,11 @@ class Medium:
         z_from, z_to : float
             Ranges from the aperture plane, metres.
 
+        Raises
+        ------
+        ValueError
+            When neither end lies in the air.
+
         Examples
         --------
         >>> m = Medium.half_space(0.3, 4.0)
@@ -286,23 +426,22 @@ class Medium:
         array([1.333333])
         """
         kappa2 = np.asarray(kappa2, dtype=float)
-        lo, hi = min(z_from, z_to), max(z_from, z_to)
+        z_from, z_to = float(z_from), float(z_to)
         down = z_to >= z_from
-        j_lo, j_hi = self.region_of(lo), self.region_of(hi)
-        total = np.ones(np.shape(kappa2), dtype=complex)
-        kz_prev = None
-        for m in range(j_lo, j_hi + 1):
-            kz_m = self.kz(k, kappa2, m)
-            top = lo if m == j_lo else self.top_of(m)
-            bottom = hi if m == j_hi else self.z_interfaces[m]
-            total *= np.exp(1j * kz_m * (bottom - top))
-            if kz_prev is not None:
-                if down:
-                    total *= self.transmission(kz_prev, kz_m, self.eps[m - 1], self.eps[m])
-                else:
-                    total *= self.transmission(kz_m, kz_prev, self.eps[m], self.eps[m - 1])
-            kz_prev = kz_m
-        return total
+        z_air, z_far = (z_from, z_to) if down else (z_to, z_from)
+        if self.region_of(z_air) != 0:
+            raise ValueError("vertical_transfer needs one end in the air above the surface "
+                             f"(range < {self.z_interfaces[0]} m), got z_from={z_from}, "
+                             f"z_to={z_to}")
+        region = self.region_of(z_far)
+        kz0 = self.kz(k, kappa2, 0)
+        if region == 0:
+            return np.exp(1j * kz0 * (z_far - z_air))
+        st = self._interfaces(k, kappa2)
+        air = np.exp(1j * kz0 * (self.z_interfaces[0] - z_air))
+        if down:
+            return air * self._field_in(st, region, z_far)
+        return air * self._up_from(st, region, z_far)
 
     def reflection(self, k: float, kappa2: np.ndarray) -> np.ndarray:
         """Reflection coefficient of the whole stack seen from the air at the surface.
@@ -316,20 +455,9 @@ class Medium:
         (-0.5+0j)
         """
         kappa2 = np.asarray(kappa2, dtype=float)
-        nreg = self.n_regions
-        if nreg == 1:
+        if self.n_regions == 1:
             return np.zeros(np.shape(kappa2), dtype=complex)
-        kzs = [self.kz(k, kappa2, m) for m in range(nreg)]
-        r = np.zeros(np.shape(kappa2), dtype=complex)
-        for m in range(nreg - 2, -1, -1):
-            r_m = self.fresnel_reflection(kzs[m], kzs[m + 1], self.eps[m], self.eps[m + 1])
-            if m + 1 < nreg - 1:
-                h = self.z_interfaces[m + 1] - self.z_interfaces[m]
-                ph = np.exp(2j * kzs[m + 1] * h)
-                r = (r_m + r * ph) / (1 + r_m * r * ph)
-            else:
-                r = r_m
-        return r
+        return self._interfaces(k, kappa2).rho[0]
 
     def crossings(self, z: float) -> list[tuple[int, float]]:
         """``(region, thickness)`` of every region crossed from the aperture plane to ``z``.
