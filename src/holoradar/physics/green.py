@@ -27,15 +27,17 @@ tests).
 
 from __future__ import annotations
 
+import functools
 import itertools
 from typing import Literal
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 from scipy.special import j0
 
 from .medium import Medium
 
-__all__ = ["free_space_green", "layered_green"]
+__all__ = ["free_space_green", "green_at_distances", "layered_green"]
 
 _NODES_PER_RADIAN = 2.0
 _MIN_NODES = 256
@@ -51,8 +53,18 @@ def free_space_green(k: complex, src: np.ndarray, pts: np.ndarray) -> np.ndarray
     return np.exp(1j * k * R) / R
 
 
-def _gauss(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+@functools.lru_cache(maxsize=64)
+def _legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    # Gauss-Legendre rules cost an eigenvalue problem of size n: computed once per n.
     x, w = np.polynomial.legendre.leggauss(n)
+    x.setflags(write=False)
+    w.setflags(write=False)
+    return x, w
+
+
+def _gauss(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    n = -(-n // 32) * 32  # a multiple of 32: few distinct rules, all cached
+    x, w = _legendre(n)
     return 0.5 * (b - a) * x + 0.5 * (b + a), 0.5 * (b - a) * w
 
 
@@ -96,20 +108,59 @@ def layered_green(k: float, medium: Medium, src: np.ndarray, pts: np.ndarray, *,
             raise ValueError("reflected: source and points must lie in the air above the surface")
         if medium.is_free_space:
             return np.zeros(len(pts), complex)
-        z0 = medium.z_interfaces[0]
-        air_path = (z0 - zs) + (z0 - pts[:, 2])  # (P,)
     out = np.empty(len(pts), complex)
     # Group points by range: each range needs its own vertical transfer.
     zkeys, inverse = np.unique(np.round(pts[:, 2], 12), return_inverse=True)
-    for iz, zr in enumerate(zkeys):
+    for iz in range(zkeys.size):
         sel = np.nonzero(inverse == iz)[0]
-        for c0 in range(0, sel.size, chunk):
-            idx = sel[c0:c0 + chunk]
-            if kind == "reflected":
-                out[idx] = _reflected(k, medium, rho[idx], air_path[idx])
-            else:
-                out[idx] = _transmitted(k, medium, zs, float(zr), rho[idx])
+        out[sel] = green_at_distances(k, medium, float(zs), float(pts[sel[0], 2]), rho[sel],
+                                      kind=kind, chunk=chunk)
     return out
+
+
+def green_at_distances(k: float, medium: Medium, z_src: float, z_obs: float,
+                       rho: np.ndarray, *, kind: Literal["transmitted", "reflected"]
+                       = "transmitted", chunk: int = 4096) -> np.ndarray:
+    """:func:`layered_green` for one source range and one observation range.
+
+    The stack is invariant along x and y, so the field depends on the lateral
+    distances ``rho`` (any shape, metres) only. When there are many of them, the
+    field is computed once on a radial grid (lambda/16 in the densest layer) and
+    interpolated by cubic splines of its amplitude and unwrapped phase: both vary
+    on the scale of the ranges, not of the wavelength, so the spline error
+    ``(5/384) h^4 max|f^(4)|`` is ~1e-11 (tested against direct evaluation).
+
+    Examples
+    --------
+    >>> m = Medium.half_space(0.3, 4.0)
+    >>> g = green_at_distances(200.0, m, 0.0, 0.1, np.array([0.0, 0.2]), kind="reflected")
+    >>> np.round(np.abs(g), 4)   # ~ |V(theta)|/R' from the mirror image at range 0.5 m
+    array([0.6666, 0.6653])
+    """
+    rho = np.asarray(rho, dtype=float)
+    flat = rho.ravel()
+    if kind == "reflected":
+        z0 = medium.z_interfaces[0]
+        air = (z0 - z_src) + (z0 - z_obs)
+
+        def field(r: np.ndarray) -> np.ndarray:
+            return _reflected(k, medium, r, np.full(r.size, air))
+    else:
+        def field(r: np.ndarray) -> np.ndarray:
+            return _transmitted(k, medium, z_src, z_obs, r)
+
+    if medium.is_free_space or (kind == "transmitted"
+                                and medium.region_of(z_obs) == medium.region_of(z_src)):
+        return field(flat).reshape(rho.shape)  # closed form
+    step = 2 * np.pi / (k * max(abs(medium.n(m)) for m in range(medium.n_regions))) / 16
+    grid = np.arange(flat.min(initial=0.0), flat.max(initial=0.0) + 3 * step, step)
+    if flat.size <= 2 * grid.size:
+        parts = [field(flat[c0:c0 + chunk]) for c0 in range(0, flat.size, chunk)]
+        return (np.concatenate(parts) if parts else np.zeros(0, complex)).reshape(rho.shape)
+    prof = np.concatenate([field(grid[c0:c0 + chunk]) for c0 in range(0, grid.size, chunk)])
+    amp = CubicSpline(grid, np.abs(prof))(flat)
+    phase = CubicSpline(grid, np.unwrap(np.angle(prof)))(flat)
+    return (amp * np.exp(1j * phase)).reshape(rho.shape)
 
 
 def _phase_length(medium: Medium, lo: float, hi: float) -> float:

@@ -32,7 +32,8 @@ import scipy.fft as sfft
 
 from .medium import Medium
 
-__all__ = ["AngularSpectrum", "Fresnel", "clear_transfer_cache", "lateral_travel",
+__all__ = ["DEFAULT_SNR_DB", "AngularSpectrum", "Fresnel", "absorption_gain",
+           "clear_transfer_cache", "lateral_travel",
            "loss_exponent", "padded_shape", "spectral_axes"]
 
 
@@ -92,20 +93,80 @@ def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np
 def loss_exponent(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
     """``sum_j Im(kz_j) * h_j`` over the layers a component crosses from range ``z`` to 0.
 
-    Counted only for components that propagate (``kappa^2 < k^2 Re(eps_j)``) in every
-    layer crossed, 0 elsewhere: it is the absorption of a travelling wave, not the
-    decay of an evanescent one. ``exp(-loss_exponent)`` is its one-way amplitude loss.
+    Counted in each layer where the component travels (``kappa^2 < k^2 Re(eps_j)``),
+    not where it is evanescent: it is the absorption of a travelling wave, not the
+    decay of an evanescent one (a component evanescent across the air gap but
+    travelling in the ground is absorbed there all the same).
+    ``exp(-loss_exponent)`` is its one-way amplitude loss.
     """
     kappa2 = np.asarray(kappa2, dtype=float)
     total = np.zeros(np.shape(kappa2))
-    propagating = np.ones(np.shape(kappa2), dtype=bool)
     for m, h in medium.crossings(z):
-        propagating &= kappa2 < k * k * complex(medium.eps[m]).real
-        total += medium.kz(k, kappa2, m).imag * h
-    return np.where(propagating, total, 0.0)
+        travels = kappa2 < k * k * complex(medium.eps[m]).real
+        total += np.where(travels, medium.kz(k, kappa2, m).imag * h, 0.0)
+    return total
 
 
-_MAX_LOSS_GAIN = 100.0  # at most 40 dB of absorption is undone by compensate_loss
+DEFAULT_SNR_DB = 40.0
+
+
+_MAX_LOSS_NEPER = 600.0  # beyond exp(-600) nothing returns from a plane: not undone
+
+
+def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
+                    snr_db: float = DEFAULT_SNR_DB) -> np.ndarray:
+    """Gain that undoes the absorption of the back-propagation to range ``z`` (loss compensation).
+
+    The adjoint ``conj(U)`` carries each travelling component's one-way absorption
+    ``a = exp(-sum_j Im(kz_j) h_j)`` once more (:func:`loss_exponent`). That extra
+    factor falls with depth and tilts the image's depth profile towards the
+    surface (the plain adjoint's focus is biased shallow). The gain is
+
+        g = (1/a0) * (1 + e) / (a/a0 + e),    e = 10^(-snr_db/20),
+
+    with ``a0`` the absorption of the vertical component (the least absorbed
+    one in horizontally layered ground). So ``conj(U) g`` is
+
+    * ``conj(U)/a``, phase and transmissions only, for every component absorbed
+      within the data's dynamic range of the vertical one (``a/a0 >> e``): the
+      depth profile is not tilted, at any depth (no cap: a cap would let the
+      bias return beyond it);
+    * ``conj(U) (1 + e)/(a0 e)`` for components absorbed below the noise relative
+      to it: weighted by their amplitude, as in the matched filter (best SNR).
+
+    Consequences: the compensated image's noise is never above that of a
+    lossless back-propagation (``a g <= 1 + e``; the plain adjoint's noise falls
+    with depth as ``a``); within a plane, the weights differ from the matched
+    filter's only by the spread of ``g`` over the components that carry the
+    signal, so the image SNR there stays within the Kantorovich bound
+    ``2 sqrt(K)/(1 + K)`` of the matched filter's, ``K`` that spread. Lossless
+    components get gain 1; evanescent ones (``loss_exponent`` 0) at most 1 + e.
+
+    Parameters
+    ----------
+    k : float
+        Wavenumber in air, rad/m.
+    medium : Medium
+    kappa2 : ndarray
+        ``p^2 + q^2``, rad^2/m^2.
+    z : float
+        Range of the image plane, metres.
+    snr_db : float
+        Signal-to-noise ratio of the data, dB (default 40).
+
+    Examples
+    --------
+    >>> clay = Medium.half_space(0.3, 12 + 3j)
+    >>> kappa2 = np.array([0.0, 150.0**2])
+    >>> a = np.exp(-loss_exponent(200.0, clay, kappa2, 0.4))   # 75 dB absorbed
+    >>> (absorption_gain(200.0, clay, kappa2, 0.4) * a).round(4)   # undone: phase only
+    array([1.    , 0.9978])
+    """
+    e = 10.0 ** (-float(snr_db) / 20)
+    loss = loss_exponent(k, medium, kappa2, z)
+    loss0 = min(float(loss_exponent(k, medium, np.array(0.0), z)), _MAX_LOSS_NEPER)
+    rel = np.exp(-np.clip(loss - loss0, 0.0, None))
+    return np.exp(loss0) * (1 + e) / (rel + e)
 
 
 class _TransferCache:
@@ -152,7 +213,7 @@ def clear_transfer_cache() -> None:
 
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                       medium: Medium, band_limit: bool, dtype: np.dtype,
-                      conjugate: bool, compensate_loss: bool = False) -> np.ndarray:
+                      conjugate: bool, compensate_loss: float | None = None) -> np.ndarray:
     key = (shape, dx, dy, k, z, medium, band_limit, np.dtype(dtype).str, conjugate,
            compensate_loss)
     return _CACHE.get(key, lambda: _make_angular_transfer(*key[:7], np.dtype(dtype),
@@ -161,7 +222,7 @@ def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z:
 
 def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                            medium: Medium, band_limit: bool, dtype: np.dtype,
-                           conjugate: bool, compensate_loss: bool) -> np.ndarray:
+                           conjugate: bool, compensate_loss: float | None) -> np.ndarray:
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
     U = medium.vertical_transfer(k, kappa2, z, 0.0)
@@ -176,10 +237,10 @@ def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: floa
             ok = ((np.abs(p[None, :]) * t <= nx * dx / 2)
                   & (np.abs(q[:, None]) * t <= ny * dy / 2))
         U = np.where(ok | (kappa2 > k * k), U, 0)
-    if conjugate and compensate_loss:
-        # Undo the absorption of the back-propagation, keep its phase and transmissions:
-        # the adjoint's extra exp(-Im(kz) h) favours shallow planes in lossy ground.
-        U = U * np.minimum(np.exp(loss_exponent(k, medium, kappa2, z)), _MAX_LOSS_GAIN)
+    if conjugate and compensate_loss is not None:
+        # Undo the absorption of the back-propagation where the component stands above
+        # the noise (the adjoint's extra exp(-Im(kz) h) favours shallow planes).
+        U = U * absorption_gain(k, medium, kappa2, z, compensate_loss)
     U = (U.conj() if conjugate else U).astype(dtype, copy=False)
     U.setflags(write=False)
     return U
@@ -191,7 +252,8 @@ class _PlaneOperator(ABC):
     def __init__(self, shape: tuple[int, int], dx: float, dy: float, k: float,
                  z: float | Sequence[float], medium: Medium | None = None,
                  pad: bool | float = True, dtype: type = np.complex128, *,
-                 band_limit: bool = True, compensate_loss: bool = False) -> None:
+                 band_limit: bool = True, compensate_loss: bool = False,
+                 snr_db: float = DEFAULT_SNR_DB) -> None:
         self.shape = (int(shape[0]), int(shape[1]))
         self.dx, self.dy, self.k = float(dx), float(dy), float(k)
         self.z = np.atleast_1d(np.asarray(z, dtype=float))
@@ -202,6 +264,9 @@ class _PlaneOperator(ABC):
         self.dtype = np.dtype(dtype)
         self.band_limit = bool(band_limit)
         self.compensate_loss = bool(compensate_loss)
+        self.snr_db = float(snr_db)
+        # The cache key of the adjoint's absorption gain: None when not compensated.
+        self._gain_key = self.snr_db if self.compensate_loss else None
         self._transfers: list[np.ndarray] | None = None
         self._adjoint: list[np.ndarray] | None = None
 
@@ -291,8 +356,11 @@ class AngularSpectrum(_PlaneOperator):
         Evanescent components are kept (they decay).
     compensate_loss : bool
         Adjoint only: undo the absorption ``exp(-Im(kz)*h)`` of each propagating
-        component in lossy layers (at most 40 dB), keeping phase and
-        transmissions. Default False: the exact adjoint.
+        component in lossy layers where it stays above the noise, keeping phase
+        and transmissions (:func:`absorption_gain`). Default False: the exact
+        adjoint.
+    snr_db : float
+        Signal-to-noise ratio of the data that limits that gain, dB (default 40).
 
     Examples
     --------
@@ -304,7 +372,7 @@ class AngularSpectrum(_PlaneOperator):
 
     def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
         return _angular_transfer(self.fft_shape, self.dx, self.dy, self.k, z, self.medium,
-                                 self.band_limit, self.dtype, conjugate, self.compensate_loss)
+                                 self.band_limit, self.dtype, conjugate, self._gain_key)
 
 
 class Fresnel(_PlaneOperator):
@@ -329,8 +397,7 @@ class Fresnel(_PlaneOperator):
         L = self.medium.apparent_distance(z)
         T0 = complex(self.medium.vertical_transfer(self.k, np.array(0.0), z, 0.0))
         if conjugate and self.compensate_loss:
-            T0 *= min(float(np.exp(loss_exponent(self.k, self.medium, np.array(0.0), z))),
-                      _MAX_LOSS_GAIN)
+            T0 *= float(absorption_gain(self.k, self.medium, np.array(0.0), z, self.snr_db))
         r2 = oy[:, None] ** 2 + ox[None, :] ** 2
         kern = (T0 * self.k / (2j * np.pi * L) * np.exp(1j * self.k * r2 / (2 * L))
                 * self.dx * self.dy)
