@@ -171,22 +171,26 @@ def _planar_target(k: float, medium: Medium, source: object, t: PlanarTarget,
     p = np.arange(-m, m + 1) * dp
     P, Q = np.meshgrid(p, p)
     kap2 = P * P + Q * Q
-    U = medium.vertical_transfer(k, kap2, t.z, 0.0)
-    travel = np.sqrt(kap2) * lateral_travel(k, medium, kap2, t.z)
-    with np.errstate(invalid="ignore"):
-        u = np.clip((travel - reach) / reach, 0, 1)
-    taper = np.where(np.isfinite(travel) & (kap2 < k * k), 0.5 * (1 + np.cos(np.pi * u)), 0)
-    U = U * taper
+    travel0 = np.sqrt(kap2) * lateral_travel(k, medium, kap2, t.z)  # from t.z up to range 0
+    kz0 = medium.kz(k, kap2, 0).real
     # Continuous FT of the object's field: S(q, p) = sum s exp(-i(p x + q y)) d^2.
     Ey = np.exp(-1j * np.outer(p, ys))
     Ex = np.exp(-1j * np.outer(xs, p))
     S = Ey @ s @ Ex * (dx * dy)
-    A = S * U * dp * dp / (4 * np.pi**2)
-    # Direct (non-uniform) inverse Fourier sum at the receivers.
     out = np.empty(len(pts), complex)
-    for c0 in range(0, len(pts), 2048):
-        c = pts[c0:c0 + 2048]
-        ey = np.exp(1j * np.outer(c[:, 1], p))      # (N, nq)
-        ex = np.exp(1j * np.outer(c[:, 0], p))      # (N, np)
-        out[c0:c0 + 2048] = np.sum((ey @ A) * ex, axis=1)
+    # Each receiver range has its own transfer (and its rays their own lateral travel).
+    for zr in np.unique(pts[:, 2]):
+        idx = np.nonzero(pts[:, 2] == zr)[0]
+        U = medium.vertical_transfer(k, kap2, t.z, float(zr))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            travel = travel0 - np.sqrt(kap2) * zr / np.where(kz0 > 0, kz0, np.nan)
+            u = np.clip((travel - reach) / reach, 0, 1)
+        taper = np.where(np.isfinite(travel) & (kap2 < k * k), 0.5 * (1 + np.cos(np.pi * u)), 0)
+        A = S * U * taper * dp * dp / (4 * np.pi**2)
+        # Direct (non-uniform) inverse Fourier sum at the receivers.
+        for c0 in range(0, idx.size, 2048):
+            c = pts[idx[c0:c0 + 2048]]
+            ey = np.exp(1j * np.outer(c[:, 1], p))      # (N, nq)
+            ex = np.exp(1j * np.outer(c[:, 0], p))      # (N, np)
+            out[idx[c0:c0 + 2048]] = np.sum((ey @ A) * ex, axis=1)
     return out
