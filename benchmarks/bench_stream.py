@@ -1,4 +1,4 @@
-"""Frame rate of glare suppression + coherent synthesis (issue 3), against its FFTs.
+"""Frame rate of glare suppression + coherent synthesis, against its FFTs.
 
 Six 16 x 16 views (the paper's array, a horn at six positions over sand), the
 glare of each fitted and removed, the six views migrated through the sand and

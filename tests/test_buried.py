@@ -1,6 +1,6 @@
 """A point buried in a half-space: true range with the medium, apparent range without.
 
-PHYSICS.md section 6: paraxially, depth d in a medium of index n diffracts like d/n of
+Paper section 3.2: paraxially, depth d in a medium of index n diffracts like d/n of
 air, so free-space migration focuses near L = z0 + d/n; migration through the medium
 (each layer's kz, each interface's transmission) focuses at the true range.
 """

@@ -1,4 +1,4 @@
-"""Independent full-wave holograms (tests/data, copied from ../shared/fixtures).
+"""Independent full-wave holograms (tests/data, independent full-wave fixtures).
 
 Frames: the fixtures' z points UP with the sand surface at z = 0 and receivers at
 z = +0.30 m; holoradar's z is range from the aperture, so z_ours = 0.30 - z_fixture.
@@ -67,7 +67,7 @@ def test_smuthi_buried_sphere_focuses_at_its_mirror_focus(inc):
 
 def test_smuthi_sphere_without_medium_sits_near_apparent_distance():
     # Free-space migration places the sphere's mirror focus (a/2 above its centre, see
-    # above) near its apparent distance L = z0 + d/n (PHYSICS.md section 6) plus the
+    # above) near its apparent distance L = z0 + d/n (paper section 3.2) plus the
     # focal shift, within a quarter of the depth response (paraxial: FWHM of theory).
     with np.load(DATA / "S2_buried_sphere_metal_inc+00.npz") as d:
         f = float(d["f_hz"][0])

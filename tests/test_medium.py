@@ -15,7 +15,7 @@ K = 2 * np.pi * F0 / hr.C0
 @pytest.mark.parametrize("pol", ["TE", "TM"])
 @pytest.mark.parametrize("eps", [2.5, 9.0, 4.0 + 0.3j])
 def test_normal_incidence_coefficients(eps, pol):
-    # PHYSICS.md section 6: V = (1 - n)/(1 + n), W = 2/(1 + n), back out 2n/(1 + n), for
+    # Paper section 3.2: V = (1 - n)/(1 + n), W = 2/(1 + n), back out 2n/(1 + n), for
     # either polarisation (the scalar field is the tangential electric field).
     n = np.sqrt(complex(eps))
     m = hr.Medium.half_space(0.3, eps, polarization=pol)
@@ -102,7 +102,7 @@ def test_layer_of_same_medium_is_invisible():
 
 
 def test_attenuation_in_lossy_layer():
-    # Amplitude decays as exp(-k Im(n) d) at normal incidence (PHYSICS.md section 6).
+    # Amplitude decays as exp(-k Im(n) d) at normal incidence (paper section 3.2).
     eps = 2.5 + 0.0125j
     m = hr.Medium.half_space(0.3, eps)
     d = 0.2

@@ -1,6 +1,6 @@
 """Migration of closed-form fields: point-source focus, resolution, spectral window.
 
-PHYSICS.md sections 2 and 4.
+Paper sections 3.1 and the spectral-window theory (Eqs. 5-7).
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ def test_fresnel_differs_outside_paraxial_regime():
 
 @pytest.mark.parametrize("tilt_deg", [(12.0, -6.0), (0.0, 0.0), (-8.0, 15.0)])
 def test_spectral_window_of_tilted_illumination(tilt_deg):
-    # PHYSICS.md section 4: for an object f lit at (p0, q0), the chirped image with the
+    # Paper Eqs. 5-7: for an object f lit at (p0, q0), the chirped image with the
     # incident phase removed, g~ conj(E0), has spectrum F~(p, q) on the rectangle
     # |p + p0| <= mu, |q + q0| <= nu. A 40 cm patch of random (white) reflectivity fills
     # that rectangle; its speckle is averaged over 4 realisations and over the other

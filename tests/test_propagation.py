@@ -1,6 +1,6 @@
 """Propagators: dot tests (forward vs adjoint), identities, closed forms.
 
-PHYSICS.md section 2: migration is the adjoint of forward propagation.
+Migration is the adjoint of forward propagation.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Surface-glare suppression and the ground's permittivity from the glare (PHYSICS.md 7)."""
+"""Surface-glare suppression and the ground's permittivity from the glare (paper section 3.3)."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def _glare_left_db(cleaned: hr.Hologram, full: hr.Hologram, targets: hr.Hologram
 @pytest.mark.parametrize(("method", "options"), [
     ("gaussian", {}), ("gaussian", {"fit_domain": "mirror"}), ("image_source", {})])
 def test_model_subtraction_removes_the_glare_and_keeps_the_object(method, options):
-    # Issue 3: glare 30 dB above the object at the aperture; subtraction must lower the
+    # Glare 30 dB above the object at the aperture; subtraction must lower the
     # glare in the object-plane image by >= 20 dB and keep >= 80% of the object's
     # glare-free peak (measured at the peak pixel of the glare-free image).
     full, targets = _scene()  # no direct wave in these data: the horn's amplitude (1) is

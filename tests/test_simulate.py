@@ -1,4 +1,4 @@
-"""Forward simulation against closed forms (PHYSICS.md sections 3 and 6)."""
+"""Forward simulation against closed forms (paper sections 2.3 and 3.2)."""
 
 from __future__ import annotations
 
@@ -218,7 +218,9 @@ def test_buried_planar_target_crosses_the_surface_both_ways(eps):
 
     ref = []
     for x, y, z in pts:
-        def f(kap, rho=np.hypot(x, y), z=z):
+        rho = float(np.hypot(x, y))
+
+        def f(kap, rho=rho, z=z):
             k0, k1 = kz(1.0, kap), kz(eps, kap)
             return (np.pi * w * w * np.exp(-kap**2 * w * w / 4) * 2 * k1 / (k0 + k1)
                     * np.exp(1j * (k1 * d + k0 * (z0 - z))) * j0(kap * rho) * kap / (2 * np.pi))

@@ -1,4 +1,4 @@
-"""Multi-view synthesis (PHYSICS.md section 5, paper Figs. 11 and 22)."""
+"""Multi-view synthesis (paper section 3.1, Figs. 11 and 22)."""
 
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def _width(img: hr.Image) -> float:
 
 def test_coherent_synthesis_narrows_to_the_union_window():
     # Union of three tiling windows: half-width 3 mu, so the first null of the point
-    # image moves from pi/mu to pi/(3 mu) (PHYSICS.md section 5); issue's bound 15%.
+    # image moves from pi/mu to pi/(3 mu); bound 15%.
     views, mu = _tiled_views()
     img = hr.synthesize(views, 1.0, mode="coherent", upsample=8)
     assert abs(_width(img) / (np.pi / (3 * mu)) - 1) < 0.15
@@ -53,7 +53,7 @@ def test_amplitude_synthesis_does_not_narrow():
 @pytest.mark.parametrize("scene", ["point", "letter_r"])
 def test_quasi_coherent_recovers_coherent_under_random_view_phases(scene):
     # Each view gets an unknown constant phase (a drifting reference); the estimator
-    # must undo it: correlation with the coherent image > 0.95 (issue 3). The relative
+    # must undo it: correlation with the coherent image > 0.95. The relative
     # phase of two views is carried only by the object frequencies both record, so an
     # extended scene needs overlapping windows: tilts of 0.75 mu overlap them by a
     # quarter. (A point, whose spectrum is flat, is aligned even by tiling windows.)

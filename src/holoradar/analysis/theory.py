@@ -1,4 +1,4 @@
-"""Closed-form theory of holographic imaging (PHYSICS.md sections 4, 6).
+"""Closed-form theory of holographic imaging (paper sections 3.1-3.2, docs/imaging.md).
 
 All lengths in metres, frequencies in Hz, angles in radians, wavenumbers in
 rad/m. Apertures are FULL widths A, B (half-widths a = A/2, b = B/2).
@@ -91,7 +91,7 @@ class SpectralWindow:
     shifts the object's spectrum to ``F(p - p0, q - q0)``, the object's own
     spectrum (incident phase removed) is seen over ``|p + p0| <= mu``,
     ``|q + q0| <= nu``: the window centred at :attr:`center` = ``(-p0, -q0)``
-    (PHYSICS.md section 5, with ``F = ∫ f exp(-i(px + qy))``).
+    (with ``F = ∫ f exp(-i(px + qy))``).
     """
 
     mu: float
@@ -125,7 +125,7 @@ def spectral_window(frequency: float, aperture: float, distance: float, *,
                     beta0: float = 0.0) -> SpectralWindow:
     """Spectral window of an aperture of full widths (A, B) focused at ``distance``.
 
-    ``mu = k*A/(2*L)``, ``nu = k*B/(2*L)`` (PHYSICS.md section 4); pass the
+    ``mu = k*A/(2*L)``, ``nu = k*B/(2*L)`` (paper Eqs. 5-7); pass the
     apparent distance for a buried object.
 
     Examples
@@ -142,7 +142,7 @@ def spectral_window(frequency: float, aperture: float, distance: float, *,
 
 
 def lateral_resolution(wavelength: float, distance: float, aperture: float) -> float:
-    """``delta = lambda*L/A`` (first null of the sinc, PHYSICS.md section 4).
+    """``delta = lambda*L/A`` (first null of the sinc, paper section 3.1).
 
     Examples
     --------
@@ -172,7 +172,7 @@ def longitudinal_resolution(wavelength: float, distance: float, aperture: float,
     at a defocus found here by root finding. For a square aperture the result is
     ``FWHM = 4*w_h^2*lambda*(L/A)^2`` with ``A(w_h)^4 = 1/2``, ``w_h = 1.1145``, i.e.
     ``4.97*lambda*(L/A)^2``: a half-width of ``2.48*lambda*(L/A)^2`` against the
-    quarter-wave estimate ``2*lambda*(L/A)^2`` of PHYSICS.md.
+    quarter-wave estimate ``2*lambda*(L/A)^2``.
 
     Examples
     --------

@@ -1,4 +1,4 @@
-"""The paper's device and scenes (Popov et al. 2022, PHYSICS.md section 9)."""
+"""The paper's device and scenes (Popov et al., Remote Sensing 2022)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Migration: back-propagation of a hologram to image planes (wave-front inversion).
 
 ``method="angular"`` applies the adjoint of exact forward propagation,
-``IFFT2[FFT2[h] * conj(U(p, q; z))]`` (PHYSICS.md section 2; through a medium
+``IFFT2[FFT2[h] * conj(U(p, q; z))]`` (docs/imaging.md; through a medium
 U includes each layer's kz and each interface's transmission, so a buried
 object focuses at its true range). ``method="fresnel"`` is the paper's
 paraxial Eq. 3 (through a medium: at the apparent distance).

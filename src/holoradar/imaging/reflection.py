@@ -1,4 +1,4 @@
-"""Suppression of the surface glare (PHYSICS.md section 7, paper section 3.3).
+"""Suppression of the surface glare (paper section 3.3, docs/glare.md).
 
 The radiator's specular reflection from a flat ground is the wave of its mirror
 image at range ``z_m = 2*z0 - z_s``: migrated through AIR it focuses there into a

@@ -1,7 +1,7 @@
 """Multi-view synthesis: summing holograms taken with different illumination.
 
 Each view k, lit by ``E0_k``, sees the object's spectrum through its own shifted
-spectral window (PHYSICS.md section 5). Removing the view's incident phase at
+spectral window (paper section 3.1). Removing the view's incident phase at
 the image plane, ``g_k * conj(E0_k)/|E0_k|``, puts every view in the frame of the
 object; then
 
@@ -13,7 +13,7 @@ object; then
   view estimated from the data, for field data whose view-to-view phase
   reference drifts (:func:`align_phases`). Start: ``phi_k = arg <r, g'_k>``, the
   phase of the inner product of the view (incident phase removed) with the
-  strongest view ``r`` (PHYSICS.md section 5's proposal). That inner product is,
+  strongest view ``r`` (our reading of the paper's term). That inner product is,
   by Parseval, the overlap of the two views' spectra: views whose windows do not
   overlap leave it to leakage and noise. So the phases are then refined to
   maximise the sharpness ``sum |I|^4`` of the summed image (Fienup & Miller's

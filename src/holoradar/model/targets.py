@@ -4,7 +4,7 @@ A :class:`PointTarget` of amplitude ``a`` at r_t re-radiates ``a * E0(r_t)`` as 
 point source in the medium that holds it (Born). A :class:`PlanarTarget` at
 range z with reflection coefficient ``f(x, y)`` replaces the incident field by the
 reflected field ``f * E0`` just above its plane (Kirchhoff / physical optics,
-PHYSICS.md section 3), which then travels up to the aperture. Sign convention:
+the paper's Eq. 4), which then travels up to the aperture. Sign convention:
 ``f = +1`` is the paper's "1 on the object"; a perfect metal plate is ``f = -1``.
 """
 

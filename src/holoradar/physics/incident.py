@@ -1,7 +1,7 @@
 """The incident field of a source on a whole image plane, fast.
 
 Multi-view synthesis removes each view's incident phase at every pixel of the
-image planes (PHYSICS.md section 5), so it needs ``E0`` on grids of 1e4-1e6
+image planes (docs/synthesis.md), so it needs ``E0`` on grids of 1e4-1e6
 pixels. A plane wave is analytic. A point source is axially symmetric about its
 own vertical line: its Sommerfeld field is computed once on a fine radial grid
 (lambda_medium/16 apart) and interpolated in amplitude and unwrapped phase,

@@ -479,7 +479,7 @@ class Medium:
     def apparent_distance(self, z: float) -> float:
         """Paraxial apparent range ``L = sum of layer thicknesses / Re(n)`` down to ``z``.
 
-        For a half-space: ``L = z0 + (z - z0)/n`` (PHYSICS.md section 6).
+        For a half-space: ``L = z0 + (z - z0)/n`` (the paper's section 3.2).
         """
         return float(sum(h / self.n(m).real for m, h in self.crossings(z)))
 

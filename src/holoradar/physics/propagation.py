@@ -6,12 +6,12 @@ Two families, each a linear operator with a forward and an adjoint:
   ``(p, q)`` is carried by the stack transfer ``U(p, q; z)`` of
   :meth:`Medium.vertical_transfer` (``exp(i*kz*z)`` in free space). Forward maps
   an up-going field at range z to the aperture; the adjoint multiplies by
-  ``conj(U)``, which is migration (PHYSICS.md section 2): exact inverse on the
+  ``conj(U)``, which is migration (docs/imaging.md): exact inverse on the
   propagating band in a lossless medium, decaying (stable) on evanescent waves.
 * :class:`Fresnel` — the paper's paraxial Eq. 3 as a sampled convolution with
   the Fresnel kernel ``(k/(2*pi*i*L)) * exp(i*k*(x^2 + y^2)/(2*L))`` times the
-  normal-incidence stack transfer; ``L`` is the apparent distance (PHYSICS.md
-  section 6). Its adjoint convolves with the conjugate kernel.
+  normal-incidence stack transfer; ``L`` is the apparent distance
+  (docs/imaging.md). Its adjoint convolves with the conjugate kernel.
 
 Fourier convention: ``F(p, q) = sum f(x, y) exp(-i*(p*x + q*y))`` (numpy's
 forward FFT); the pair of FFTs is exactly unitary up to the usual 1/N, so
