@@ -17,7 +17,7 @@ Examples
 from . import theory
 from ._validate import AliasingWarning
 from .data.hologram import C0, Hologram, Image
-from .imaging.migrate import migrate
+from .imaging.migrate import IlluminationWarning, migrate
 from .imaging.reflection import (
     FitWarning,
     SuppressionReport,
@@ -44,6 +44,7 @@ __all__ = [
     "Fresnel",
     "GaussianBeam",
     "Hologram",
+    "IlluminationWarning",
     "Image",
     "Medium",
     "PlanarTarget",

@@ -140,10 +140,14 @@ def as_real(value: object, name: str, *, positive: bool = False,
     return v
 
 
-def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture") -> None:
-    """Warn (and go on) when a sampling pitch exceeds half a wavelength."""
-    if pitch > wavelength / 2 * (1 + 1e-9):
-        theta = np.degrees(np.arcsin(min(1.0, wavelength / (2 * pitch))))
-        warnings.warn(f"{what} pitch {pitch * 100:.3g} cm exceeds lambda/2 = "
-                      f"{wavelength * 50:.3g} cm: waves arriving more than {theta:.1f} degrees "
-                      f"off axis alias", AliasingWarning, stacklevel=3)
+def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture", *,
+                    round_trip: bool = False) -> None:
+    """Warn (and go on) when a sampling pitch exceeds half a wavelength (a quarter for a
+    transceiver's round trip, which doubles the transverse wavenumbers)."""
+    div = 4 if round_trip else 2
+    if pitch > wavelength / div * (1 + 1e-9):
+        theta = np.degrees(np.arcsin(min(1.0, wavelength / (div * pitch))))
+        label = "lambda/4 (a transceiver's round trip)" if round_trip else "lambda/2"
+        warnings.warn(f"{what} pitch {pitch * 100:.3g} cm exceeds {label} = "
+                      f"{wavelength * 100 / div:.3g} cm: waves arriving more than {theta:.1f} "
+                      f"degrees off axis alias", AliasingWarning, stacklevel=3)

@@ -58,7 +58,8 @@ def estimate_snr(hologram: Hologram, z_min: float) -> float | None:
     dx, dy = hologram.pitch
     p = 2 * np.pi * sfft.fftfreq(nx, dx)
     q = 2 * np.pi * sfft.fftfreq(ny, dy)
-    k = hologram.k
+    # The largest wavenumber any frequency carries (twice it for a transceiver's round trip).
+    k = float(hologram.wavenumbers.max()) * (2 if hologram.monostatic else 1)
     noise_bins = (q[:, None] ** 2 + p[None, :] ** 2) > k * k + (_DAMPING / z_min) ** 2
     if noise_bins.sum() < _MIN_BINS:
         return None

@@ -23,22 +23,29 @@ C0 = 299_792_458.0
 
 @dataclass(frozen=True, eq=False)
 class Hologram:
-    """A complex field sampled on the aperture plane.
+    """A complex field sampled on the aperture plane, at one or several frequencies.
 
     Parameters
     ----------
-    data : array_like, complex, shape (..., ny, nx)
-        Field (the I + iQ of each element). Leading axes are frames (views,
-        frequencies, time) processed together.
+    data : array_like, complex, shape (..., ny, nx) or (..., nf, ny, nx)
+        Field (the I + iQ of each element). With several frequencies, the
+        frequency axis is third from last. Leading axes are frames (views,
+        time) processed together.
     x : array_like, shape (nx,)
         Element x coordinates, metres, strictly increasing.
     y : array_like, shape (ny,)
         Element y coordinates, metres, strictly increasing.
-    frequency : float
-        Frequency in Hz (> 0).
+    frequency : float or array_like of shape (nf,)
+        Frequency in Hz (> 0), or nf strictly increasing frequencies (a wideband
+        hologram; ``data.shape[-3] == nf``).
     source : PlaneWave, PointSource or GaussianBeam, optional
         The illumination that produced the hologram (needed by multi-view
-        synthesis and glare suppression).
+        synthesis, glare suppression and the coherent sum of frequencies).
+    monostatic : bool
+        True for a scanned transceiver: the sample at (x, y) is the field received
+        by a transceiver at (x, y), so the wave travels there and back (round-trip
+        wavenumber 2k); it has no separate ``source``. False (default): a
+        receiver array lit by a separate source.
 
     Examples
     --------
@@ -47,23 +54,33 @@ class Hologram:
     >>> h = Hologram(np.zeros((16, 16), complex), x, x, 9.9e9)
     >>> round(h.aperture_size[0], 3), round(h.wavelength, 5)
     (0.4, 0.03028)
+    >>> w = Hologram(np.zeros((3, 16, 16)), x, x, [9e9, 10e9, 11e9], monostatic=True)
+    >>> w.nf, w.is_wideband
+    (3, True)
     """
 
     data: np.ndarray
     x: np.ndarray
     y: np.ndarray
-    frequency: float
+    frequency: float | np.ndarray
     source: Any = None
+    monostatic: bool = False
 
-    def __init__(self, data: Any, x: Any, y: Any, frequency: float, *,
-                 source: Any = None) -> None:
+    def __init__(self, data: Any, x: Any, y: Any, frequency: Any, *,
+                 source: Any = None, monostatic: bool = False) -> None:
         arr = as_finite_complex(data, "data", min_ndim=2)
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
-        f = check_frequency(frequency)
+        f = _frequency_axis(frequency, arr.shape)
         if source is not None and not (hasattr(source, "field") and hasattr(source, "reflected")):
             raise ValueError("source must be a PlaneWave, PointSource, GaussianBeam or None, got "
                              f"{type(source).__name__}")
+        if not isinstance(monostatic, bool | np.bool_):
+            raise ValueError(f"monostatic must be True or False, got {monostatic!r}")
+        if monostatic and source is not None:
+            raise ValueError("a monostatic hologram (scanned transceiver) has no separate "
+                             "source: the transceiver at each sample lights the scene itself; "
+                             "pass source=None")
         arr = arr.copy()  # the hologram owns its data: the caller's array is never shared
         arr.setflags(write=False)
         xa.setflags(write=False)
@@ -73,16 +90,63 @@ class Hologram:
         object.__setattr__(self, "y", ya)
         object.__setattr__(self, "frequency", f)
         object.__setattr__(self, "source", source)
+        object.__setattr__(self, "monostatic", bool(monostatic))
+
+    @property
+    def is_wideband(self) -> bool:
+        """True when ``frequency`` is an axis of frequencies (``data`` (..., nf, ny, nx))."""
+        return isinstance(self.frequency, np.ndarray)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The frequencies, Hz, as a 1-D array (one element for a single frequency)."""
+        return np.atleast_1d(np.asarray(self.frequency, dtype=float))
+
+    @property
+    def nf(self) -> int:
+        """Number of frequencies."""
+        return self.frequencies.size
+
+    @property
+    def wavenumbers(self) -> np.ndarray:
+        """Wavenumbers in air ``2*pi*f/c`` of every frequency, rad/m (1-D)."""
+        return 2 * np.pi * self.frequencies / C0
+
+    def _single(self, what: str) -> float:
+        if self.is_wideband:
+            raise ValueError(f"this hologram has {self.nf} frequencies: its {what} is not one "
+                             f"number (use .frequencies / .wavenumbers, or .at_frequency(i))")
+        return float(self.frequency)
 
     @property
     def wavelength(self) -> float:
-        """Wavelength in air, metres."""
-        return C0 / self.frequency
+        """Wavelength in air, metres (single-frequency holograms)."""
+        return C0 / self._single("wavelength")
 
     @property
     def k(self) -> float:
-        """Wavenumber in air, rad/m."""
-        return 2 * np.pi * self.frequency / C0
+        """Wavenumber in air, rad/m (single-frequency holograms)."""
+        return 2 * np.pi * self._single("wavenumber") / C0
+
+    def at_frequency(self, index: int) -> Hologram:
+        """The single-frequency hologram of frequency ``index`` (same geometry).
+
+        Examples
+        --------
+        >>> x = np.arange(4) * 0.01
+        >>> w = Hologram(np.ones((2, 4, 4)), x, x, [9e9, 10e9])
+        >>> w.at_frequency(1).frequency
+        10000000000.0
+        """
+        if not self.is_wideband:
+            if index not in (0, -1):
+                raise ValueError(f"index must be 0 for a single-frequency hologram, got {index}")
+            return self
+        i = int(index)
+        if not -self.nf <= i < self.nf:
+            raise ValueError(f"index must be in [0, {self.nf}), got {index}")
+        return Hologram(self.data[..., i, :, :], self.x, self.y, float(self.frequencies[i]),
+                        source=self.source, monostatic=self.monostatic)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -115,15 +179,40 @@ class Hologram:
         >>> Hologram(np.ones((4, 4)), x, x, 1e10).with_data(np.zeros((2, 4, 4))).shape
         (2, 4, 4)
         """
-        return Hologram(data, self.x, self.y, self.frequency, source=self.source)
+        return Hologram(data, self.x, self.y, self.frequency, source=self.source,
+                        monostatic=self.monostatic)
 
     def replace(self, **changes: Any) -> Hologram:
         """A copy with some fields replaced (``dataclasses.replace`` semantics)."""
         kw = {"data": self.data, "x": self.x, "y": self.y, "frequency": self.frequency,
-              "source": self.source}
+              "source": self.source, "monostatic": self.monostatic}
         kw.update(changes)
-        src = kw.pop("source")
-        return Hologram(**kw, source=src)
+        src, mono = kw.pop("source"), kw.pop("monostatic")
+        return Hologram(**kw, source=src, monostatic=mono)
+
+
+def _frequency_axis(frequency: Any, shape: tuple[int, ...]) -> float | np.ndarray:
+    """A frequency in Hz, or a strictly increasing axis matching ``shape[-3]``."""
+    if np.ndim(frequency) == 0:
+        return check_frequency(frequency)
+    try:
+        f = np.array(frequency, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"frequency must be a number in Hz or a 1-D array of them, got "
+                         f"{frequency!r}") from None
+    if f.ndim != 1 or f.size == 0:
+        raise ValueError(f"frequency must be a number in Hz or a 1-D array of them, got shape "
+                         f"{f.shape}")
+    if not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise ValueError("frequency must hold finite frequencies > 0 in Hz")
+    if np.any(np.diff(f) <= 0):
+        raise ValueError("frequency must be strictly increasing (sort the frequencies and the "
+                         "data's frequency axis together)")
+    if len(shape) < 3 or shape[-3] != f.size:
+        raise ValueError(f"data must have the frequency axis third from last, (..., {f.size}, "
+                         f"ny, nx) for {f.size} frequencies, got shape {shape}")
+    f.setflags(write=False)
+    return f
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,8 +228,8 @@ class Image:
         Pixel coordinates, metres.
     z : ndarray
         Ranges of the planes from the aperture, metres (always 1-D).
-    frequency : float
-        Frequency in Hz.
+    frequency : float or ndarray
+        Frequency in Hz (the frequencies of a wideband image).
     method : str
         How the image was formed (e.g. ``"angular"``).
     has_z_axis : bool
@@ -158,7 +247,7 @@ class Image:
     x: np.ndarray
     y: np.ndarray
     z: np.ndarray
-    frequency: float
+    frequency: float | np.ndarray
     method: str = "angular"
     has_z_axis: bool = True
 

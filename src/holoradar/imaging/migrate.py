@@ -10,22 +10,24 @@ paraxial Eq. 3 (through a medium: at the apparent distance).
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
 from tqdm.auto import tqdm
 
-from .._validate import as_real, check_nonnegative_ranges, warn_if_aliased
+from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
 from ..analysis.noise import estimate_snr
-from ..data.hologram import Hologram, Image
+from ..data.hologram import C0, Hologram, Image
+from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
 from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel
 
-__all__ = ["migrate"]
+__all__ = ["IlluminationWarning", "migrate"]
 
 _CHUNK = 8  # planes per batched inverse FFT
 _POOL_SIZE = os.cpu_count() or 1
@@ -35,13 +37,19 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
             medium: Medium | None = None, method: Literal["angular", "fresnel"] = "angular",
             pad: bool | float = True, upsample: int = 1, compensate_loss: bool = True,
             snr_db: float | None = None, fov: Literal["aperture", "full"] = "aperture",
-            dtype: type | None = None, progress: bool | None = None) -> Image:
+            dtype: type | None = None, progress: bool | None = None,
+            combine: Literal["coherent", "incoherent", "none"] = "coherent",
+            equalize: bool | Sequence[float] | np.ndarray = True) -> Image:
     """Back-propagate a hologram to the planes at range ``z``.
 
     Parameters
     ----------
     hologram : Hologram
-        Field on a uniform grid of the aperture plane, shape (..., ny, nx).
+        Field on a uniform grid of the aperture plane, shape (..., ny, nx), or
+        (..., nf, ny, nx) with nf frequencies. A monostatic hologram (scanned
+        transceiver) is back-propagated over the round trip (wavenumber 2k; in a
+        medium each layer's round-trip kz and both legs' transmissions,
+        :func:`~holoradar.physics.propagation.two_way_transfer`).
     z : float or sequence of float
         Image ranges from the aperture, metres (>= 0). A scalar gives one plane.
     medium : Medium, optional
@@ -84,12 +92,30 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         Working precision: ``np.complex64`` for speed; default that of the data.
     progress : bool, optional
         Show a progress bar; default: when the output exceeds 2e8 pixels.
-
+    combine : {"coherent", "incoherent", "none"}
+        Several frequencies: ``"coherent"`` (default) sums the complex images of
+        all frequencies, which focuses in depth (range resolution
+        ``c/(2 B Re(n))``, :func:`holoradar.theory.range_resolution`);
+        ``"incoherent"`` returns ``sqrt(sum_f |w_f I_f|^2)`` (no range focusing,
+        less speckle); ``"none"`` keeps them apart, shape (..., nf, nz, ny', nx').
+        For a receiver array lit by a separate ``hologram.source``, each
+        frequency's image is first multiplied by the unit phasor
+        ``conj(E0)/|E0|`` of its incident field at every pixel (otherwise the
+        frequencies add with the illumination's phases); without a source a
+        plane wave at normal incidence is assumed, with a warning. A monostatic
+        hologram needs no such step (the round trip is in the transfer).
+    equalize : bool or array_like
+        Weights ``w_f`` of the frequencies: True (default) normalises each
+        frequency's hologram to unit RMS (the paper's equalising factor: the
+        device's response varies across the band); False keeps the recorded
+        amplitudes; an array gives nf weights.
     Returns
     -------
     Image
         ``data`` of shape (..., nz, ny', nx') for a sequence of ranges and
-        (..., ny', nx') for a scalar, with ny' = upsample*(ny - 1) + 1 (same for x).
+        (..., ny', nx') for a scalar, with ny' = upsample*(ny - 1) + 1 (same for x);
+        with ``combine="none"``, (..., nf, nz, ny', nx'). ``Image.frequency`` holds
+        the frequencies of a wideband image.
 
     Raises
     ------
@@ -113,6 +139,11 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     """
     if not isinstance(hologram, Hologram):
         raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
+    if hologram.is_wideband:
+        return _migrate_wideband(hologram, z, medium=medium, method=method, pad=pad,
+                                 upsample=upsample, compensate_loss=compensate_loss,
+                                 snr_db=snr_db, fov=fov, dtype=dtype, progress=progress,
+                                 combine=combine, equalize=equalize)
     zs = check_nonnegative_ranges(z, "z")
     scalar = np.ndim(z) == 0
     if method not in ("angular", "fresnel"):
@@ -126,7 +157,9 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     if method == "fresnel" and np.any(zs <= 0):
         raise ValueError("z must be > 0 with method='fresnel' (its kernel is singular at 0)")
     dx, dy = hologram.pitch
-    warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram")
+    # A transceiver's round trip doubles the transverse wavenumbers: lambda/4 sampling.
+    warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram",
+                    round_trip=hologram.monostatic)
     work = np.dtype(dtype) if dtype is not None else (
         np.complex64 if hologram.data.dtype == np.complex64 else np.complex128)
     if work not in (np.complex64, np.complex128):
@@ -137,7 +170,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     else:
         snr_db = as_real(snr_db, "snr_db")
     op = cls(hologram.data.shape[-2:], dx, dy, hologram.k, zs, medium, pad, work,
-             compensate_loss=compensate_loss, snr_db=snr_db)
+             compensate_loss=compensate_loss, snr_db=snr_db, monostatic=hologram.monostatic)
     H = op.spectrum(hologram.data)
     ny, nx = op.shape
     u = int(upsample)
@@ -178,6 +211,87 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     y = hologram.y[0] + (np.arange(oy) - sy) * dy / u
     data = out[..., 0, :, :] if scalar else out
     return Image(data, x, y, zs, hologram.frequency, method, has_z_axis=not scalar)
+
+
+class IlluminationWarning(UserWarning):
+    """Frequencies were combined with an assumed incident field."""
+
+
+def _weights(hologram: Hologram, equalize: Any) -> np.ndarray:
+    nf = hologram.nf
+    if isinstance(equalize, bool | np.bool_):
+        if not equalize:
+            return np.ones(nf)
+        rms = np.sqrt(np.mean(np.abs(np.moveaxis(hologram.data, -3, 0).reshape(nf, -1)) ** 2,
+                              axis=1))
+        return np.divide(1.0, rms, out=np.zeros(nf), where=rms > 0)
+    try:
+        w = np.array(equalize, dtype=float)
+    except (TypeError, ValueError):
+        w = np.full(0, np.nan)
+    if w.shape != (nf,) or not np.all(np.isfinite(w)):
+        raise ValueError(f"equalize must be True, False or {nf} finite weights (one per "
+                         f"frequency), got {equalize!r}")
+    return w
+
+
+def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any,
+                      medium: Medium | None, **kw: Any) -> Image:
+    """The exact per-frequency sum: each frequency migrated, phased, weighted, combined."""
+    if combine not in ("coherent", "incoherent", "none"):
+        raise ValueError(f"combine must be 'coherent', 'incoherent' or 'none', got {combine!r}")
+    w = _weights(hologram, equalize)
+    if kw.get("snr_db") is None and kw.get("compensate_loss", True):
+        zs = check_nonnegative_ranges(z, "z")
+        kw["snr_db"] = _data_snr(hologram, medium, zs)
+    med = medium if medium is not None else Medium.free_space()
+    if not hologram.monostatic and hologram.source is None and combine == "coherent":
+        warnings.warn("combining frequencies without hologram.source: a plane wave at normal "
+                      "incidence is assumed for each frequency's incident phase; give the "
+                      "source for the true one", IlluminationWarning, stacklevel=3)
+    warn_if_aliased(max(hologram.pitch), C0 / hologram.frequencies[-1], "hologram",
+                    round_trip=hologram.monostatic)
+    acc: np.ndarray | None = None
+    parts = []
+    img = None
+    for i, kf in enumerate(hologram.wavenumbers):
+        with warnings.catch_warnings():  # said once above, for the highest frequency
+            warnings.simplefilter("ignore", AliasingWarning)
+            img = migrate(hologram.at_frequency(i), z, medium=medium, **kw)
+        data = img.data if img.has_z_axis else img.data[..., None, :, :]
+        if not hologram.monostatic and combine != "incoherent":
+            data = data * _incident_phasor(hologram.source, kf, med, img)
+        data = w[i] * data
+        if combine == "none":
+            parts.append(data)
+        elif combine == "coherent":
+            acc = data if acc is None else acc + data
+        else:
+            acc = np.abs(data) ** 2 if acc is None else acc + np.abs(data) ** 2
+    assert img is not None
+    if combine == "none":
+        out = np.stack(parts, axis=-4)
+    else:
+        out = np.sqrt(acc) if combine == "incoherent" else acc
+    if not img.has_z_axis:
+        out = out[..., 0, :, :]
+    return Image(out, img.x, img.y, img.z, hologram.frequencies.copy(),
+                 f"{img.method}:{combine}", has_z_axis=img.has_z_axis)
+
+
+def _incident_phasor(source: Any, k: float, medium: Medium, img: Image) -> np.ndarray:
+    """``conj(E0)/|E0|`` on every image plane (nz, ny, nx); E0 = exp(i kz0...) at normal
+    incidence without a source."""
+    out = np.empty((img.z.size, img.y.size, img.x.size), complex)
+    for j, zj in enumerate(img.z):
+        if source is None:
+            e0 = np.full((img.y.size, img.x.size), complex(
+                medium.vertical_transfer(k, np.array(0.0), 0.0, float(zj))))
+        else:
+            e0 = incident_on_plane(source, k, medium, img.x, img.y, float(zj))
+        mag = np.abs(e0)
+        out[j] = np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
+    return out
 
 
 def _data_snr(hologram: Hologram, medium: Medium | None, zs: np.ndarray) -> float:

@@ -29,6 +29,9 @@ class Aperture:
         Arbitrary element positions (x, y) in metres; use
         :meth:`from_positions`. Such an aperture is not a grid:
         :func:`holoradar.simulate` then returns the N element fields as an array.
+    monostatic : bool
+        The elements are positions of a scanned transceiver (each sends and
+        receives) rather than receivers lit by a separate source.
 
     Examples
     --------
@@ -41,6 +44,7 @@ class Aperture:
     x: np.ndarray
     y: np.ndarray
     elements: np.ndarray | None = None
+    monostatic: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "x", as_axis(self.x, "x"))
@@ -56,13 +60,13 @@ class Aperture:
             object.__setattr__(self, "elements", el)
 
     @classmethod
-    def from_positions(cls, positions: np.ndarray) -> Aperture:
+    def from_positions(cls, positions: np.ndarray, *, monostatic: bool = False) -> Aperture:
         """Elements at arbitrary positions (N, 2) on the plane z = 0, metres."""
         el = np.asarray(positions, dtype=float)
         if el.ndim != 2 or el.shape[1] != 2:
             raise ValueError(f"positions must have shape (N, 2), got {el.shape}")
         xs, ys = np.unique(el[:, 0]), np.unique(el[:, 1])
-        return cls(xs, ys, el)
+        return cls(xs, ys, el, monostatic)
 
     @property
     def is_grid(self) -> bool:
@@ -71,8 +75,11 @@ class Aperture:
 
     @classmethod
     def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
-             center: tuple[float, float] = (0.0, 0.0)) -> Aperture:
-        """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``."""
+             center: tuple[float, float] = (0.0, 0.0), monostatic: bool = False) -> Aperture:
+        """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``.
+
+        ``monostatic=True`` makes it the scan grid of one transceiver.
+        """
         for name, v in (("n", n), ("ny", ny)):
             if v is not None and (not float(v).is_integer() or int(v) < 1):
                 raise ValueError(f"{name} must be a whole number of elements >= 1, got {v!r}")
@@ -82,7 +89,7 @@ class Aperture:
         py = pitch if pitch_y is None else pitch_y
         x = (np.arange(int(n)) - (int(n) - 1) / 2) * pitch + center[0]
         y = (np.arange(ny) - (ny - 1) / 2) * py + center[1]
-        return cls(x, y)
+        return cls(x, y, monostatic=monostatic)
 
     @classmethod
     def paper(cls) -> Aperture:

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import as_real, check_frequency
-from ..data.hologram import C0, Hologram
+from ..data.hologram import C0, Hologram, _frequency_axis
 from ..physics.green import free_space_green, green_at_distances
 from ..physics.medium import Medium
 from ..physics.propagation import lateral_travel
@@ -37,10 +37,10 @@ __all__ = ["simulate"]
 _MARGIN_WAVELENGTHS = 10.0
 
 
-def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
+def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | np.ndarray, *,
              include_targets: bool = True, include_surface: bool = True,
              include_direct: bool = False, snr_db: float | None = None,
-             seed: int | None = None) -> Hologram | np.ndarray:
+             seed: int | None = None, monostatic: bool | None = None) -> Hologram | np.ndarray:
     """Simulate the hologram of ``scene`` recorded by ``aperture`` at ``frequency``.
 
     Parameters
@@ -50,26 +50,34 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
     aperture : Aperture or ndarray of shape (N, 2) or (N, 3)
         Receiver array (:meth:`Aperture.grid`, :meth:`Aperture.paper`,
         :meth:`Aperture.from_positions`), or element positions (x, y[, z]) in metres.
-    frequency : float
-        Hz.
+    frequency : float or array_like
+        Hz; an array of nf strictly increasing frequencies gives a wideband
+        hologram, data (nf, ny, nx).
     include_targets : bool
         Add the field scattered by the targets (default True).
     include_surface : bool
         Add the specular reflection of the source from the ground (default True;
-        nothing in free space).
+        nothing in free space). Monostatic: each transceiver's own reflection.
     include_direct : bool
         Add the source's own field at the aperture (default False: a horn beside
         the array radiates away from it; a plane wave passes through it).
     snr_db : float, optional
-        Add receiver noise: ``10*log10(mean |signal|^2 / noise variance)``.
+        Add receiver noise: ``10*log10(mean |signal|^2 / noise variance)``, for
+        each frequency.
     seed : int, optional
         Seed of the noise generator.
+    monostatic : bool, optional
+        A scanned transceiver: each element is a point source ``exp(i*k*R)/R`` that
+        receives its own echo, so a point target of amplitude ``a`` returns
+        ``a * G(element, target)^2`` (``G`` the exact layered Green's function,
+        symmetric by reciprocity); the scene's source is not used. Default: the
+        aperture's own ``monostatic`` (False for bare positions).
 
     Returns
     -------
     Hologram
         For a grid :class:`Aperture` (its ``source`` is the scene's); for elements
-        at arbitrary positions, a complex array (N,) of their fields.
+        at arbitrary positions, a complex array (N,) or (nf, N) of their fields.
 
     Examples
     --------
@@ -79,11 +87,17 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
     >>> h = hr.simulate(scene, hr.Aperture.paper(), 9.9e9, include_surface=False)
     >>> h.shape
     (16, 16)
+    >>> w = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))]),
+    ...                 hr.Aperture.grid(8, 0.005, monostatic=True), [9e9, 10e9, 11e9])
+    >>> w.shape, w.monostatic
+    ((3, 8, 8), True)
     """
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be a holoradar.Scene, got {type(scene).__name__}")
-    f = check_frequency(frequency)
-    k = 2 * np.pi * f / C0
+    if np.ndim(frequency) == 0:
+        freqs, wide = np.array([check_frequency(frequency)]), False
+    else:
+        freqs, wide = _frequency_axis(frequency, (np.size(frequency), 1, 1)), True
     if isinstance(aperture, Aperture):
         pts = aperture.points
     else:
@@ -93,9 +107,46 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
                              f"(N, 2) or (N, 3) in metres, got shape {pts.shape}")
         if pts.shape[1] == 2:
             pts = np.c_[pts, np.zeros(len(pts))]
+    mono = (bool(getattr(aperture, "monostatic", False)) if monostatic is None
+            else bool(monostatic))
     medium, source = scene.medium, scene.source
     if not medium.is_free_space and np.any(pts[:, 2] >= medium.z_interfaces[0]):
         raise ValueError("aperture elements must lie above the ground surface")
+    if mono and include_direct:
+        raise ValueError("include_direct has no meaning for a monostatic aperture (a "
+                         "transceiver's coupling to itself is not modelled)")
+    if mono and any(isinstance(t, PlanarTarget) for t in scene.targets):
+        raise ValueError("planar targets are not modelled for a monostatic aperture (each "
+                         "transceiver would need its own Kirchhoff integral); use point "
+                         "targets, e.g. a grid of them over the object")
+    rng = np.random.default_rng(seed)
+    rows = []
+    for f in freqs:
+        k = 2 * np.pi * f / C0
+        if mono:
+            total = _monostatic(k, medium, scene, pts, include_targets, include_surface)
+        else:
+            total = _bistatic(k, medium, scene, pts, include_targets, include_surface,
+                              include_direct)
+        if snr_db is not None:
+            power = float(np.mean(np.abs(total) ** 2))
+            sigma = np.sqrt(power / 10 ** (as_real(snr_db, "snr_db") / 10) / 2)
+            total = total + sigma * (rng.standard_normal(total.shape)
+                                     + 1j * rng.standard_normal(total.shape))
+        rows.append(total)
+    data = np.stack(rows) if wide else rows[0]
+    if isinstance(aperture, Aperture) and aperture.is_grid:
+        shape = (*data.shape[:-1], aperture.y.size, aperture.x.size)
+        return Hologram(data.reshape(shape), aperture.x, aperture.y,
+                        freqs if wide else float(freqs[0]),
+                        source=None if mono else source, monostatic=mono)
+    return data
+
+
+def _bistatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray, include_targets: bool,
+              include_surface: bool, include_direct: bool) -> np.ndarray:
+    """A receiver array lit by the scene's source."""
+    source = scene.source
     total = np.zeros(len(pts), complex)
     if include_targets:
         points = [t for t in scene.targets if isinstance(t, PointTarget)]
@@ -108,16 +159,35 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float, *,
         total += source.reflected(k, medium, pts)
     if include_direct:
         total += source.field(k, medium, pts)
-    if snr_db is not None:
-        snr_db = as_real(snr_db, "snr_db")
-        rng = np.random.default_rng(seed)
-        power = float(np.mean(np.abs(total) ** 2))
-        sigma = np.sqrt(power / 10 ** (snr_db / 10) / 2)
-        total = total + sigma * (rng.standard_normal(total.shape)
-                                 + 1j * rng.standard_normal(total.shape))
-    if isinstance(aperture, Aperture) and aperture.is_grid:
-        return Hologram(total.reshape(aperture.y.size, aperture.x.size), aperture.x, aperture.y,
-                        f, source=source)
+    return total
+
+
+def _monostatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
+                include_targets: bool, include_surface: bool) -> np.ndarray:
+    """Scanned transceivers: each element's echo of its own point-source wave."""
+    total = np.zeros(len(pts), complex)
+    if include_targets:
+        targets = [t for t in scene.targets if isinstance(t, PointTarget)]
+        for zt in sorted({float(t.position[2]) for t in targets}):
+            group = [t for t in targets if t.position[2] == zt]
+            pos = np.array([t.position for t in group])
+            amp = np.array([t.amplitude for t in group])
+            for zr in np.unique(pts[:, 2]):
+                sel = pts[:, 2] == zr
+                d = pts[None, sel, :2] - pos[:, None, :2]
+                rho = np.hypot(d[..., 0], d[..., 1])
+                if medium.is_free_space:
+                    R = np.hypot(rho, zt - zr)
+                    g = np.exp(1j * k * R) / R
+                else:
+                    g = green_at_distances(k, medium, float(zt), float(zr), rho)
+                total[sel] += amp @ (g * g)  # reciprocity: down and up are the same G
+    if include_surface and not medium.is_free_space:
+        # Each transceiver's own glare: the reflected field at its own position.
+        for zr in np.unique(pts[:, 2]):
+            sel = pts[:, 2] == zr
+            total[sel] += green_at_distances(k, medium, float(zr), float(zr), np.zeros(1),
+                                             kind="reflected")[0]
     return total
 
 

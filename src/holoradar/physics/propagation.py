@@ -32,9 +32,18 @@ import scipy.fft as sfft
 
 from .medium import Medium
 
-__all__ = ["DEFAULT_SNR_DB", "AngularSpectrum", "Fresnel", "absorption_gain",
-           "clear_transfer_cache", "lateral_travel",
-           "loss_exponent", "padded_shape", "spectral_axes"]
+__all__ = [
+    "DEFAULT_SNR_DB",
+    "AngularSpectrum",
+    "Fresnel",
+    "absorption_gain",
+    "clear_transfer_cache",
+    "lateral_travel",
+    "loss_exponent",
+    "padded_shape",
+    "spectral_axes",
+    "two_way_transfer",
+]
 
 
 def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[float, float]
@@ -114,7 +123,7 @@ _MAX_LOSS_NEPER = 600.0  # beyond exp(-600) nothing returns from a plane: not un
 
 
 def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
-                    snr_db: float = DEFAULT_SNR_DB) -> np.ndarray:
+                    snr_db: float = DEFAULT_SNR_DB, *, monostatic: bool = False) -> np.ndarray:
     """Gain that undoes the absorption of the back-propagation to range ``z`` (loss compensation).
 
     The adjoint ``conj(U)`` carries each travelling component's one-way absorption
@@ -153,6 +162,9 @@ def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
         Range of the image plane, metres.
     snr_db : float
         Signal-to-noise ratio of the data, dB (default 40).
+    monostatic : bool
+        Round trip of a scanned transceiver: both legs absorb, each with kappa/2
+        (:func:`two_way_transfer`).
 
     Examples
     --------
@@ -163,8 +175,9 @@ def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
     array([1.    , 0.9978])
     """
     e = 10.0 ** (-float(snr_db) / 20)
-    loss = loss_exponent(k, medium, kappa2, z)
-    loss0 = min(float(loss_exponent(k, medium, np.array(0.0), z)), _MAX_LOSS_NEPER)
+    legs, k2 = (2.0, np.asarray(kappa2, dtype=float) / 4) if monostatic else (1.0, kappa2)
+    loss = legs * loss_exponent(k, medium, k2, z)
+    loss0 = min(legs * float(loss_exponent(k, medium, np.array(0.0), z)), _MAX_LOSS_NEPER)
     rel = np.exp(-np.clip(loss - loss0, 0.0, None))
     return np.exp(loss0) * (1 + e) / (rel + e)
 
@@ -213,34 +226,68 @@ def clear_transfer_cache() -> None:
 
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                       medium: Medium, band_limit: bool, dtype: np.dtype,
-                      conjugate: bool, compensate_loss: float | None = None) -> np.ndarray:
+                      conjugate: bool, compensate_loss: float | None = None,
+                      monostatic: bool = False) -> np.ndarray:
     key = (shape, dx, dy, k, z, medium, band_limit, np.dtype(dtype).str, conjugate,
-           compensate_loss)
+           compensate_loss, monostatic)
     return _CACHE.get(key, lambda: _make_angular_transfer(*key[:7], np.dtype(dtype),
-                                                          conjugate, compensate_loss))
+                                                          conjugate, compensate_loss,
+                                                          monostatic))
+
+
+def two_way_transfer(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
+    """Round-trip transfer of a scanned transceiver's component ``(p, q)`` to range ``z``.
+
+    A monostatic sample records the wave sent down from the transceiver and
+    scattered back up to it; at stationary phase both legs carry half the
+    transverse wavenumber. So the component of transverse wavenumber kappa
+    travels down and up with ``kappa/2``:
+    ``U_mono = U_down(kappa^2/4) * U_up(kappa^2/4)``, i.e. ``exp(i*sqrt(4 k^2 - kappa^2) z)``
+    in free space (the round-trip wavenumber 2k) and, in every layer, the
+    round-trip ``kz`` with both legs' transmissions.
+
+    Examples
+    --------
+    >>> k = 200.0
+    >>> u = two_way_transfer(k, Medium.free_space(), np.array([0.0, 100.0**2]), 0.3)
+    >>> np.allclose(u, np.exp(1j * np.sqrt(4 * k**2 - np.array([0.0, 100.0**2])) * 0.3))
+    True
+    """
+    half = np.asarray(kappa2, dtype=float) / 4
+    return medium.vertical_transfer(k, half, z, 0.0) * medium.vertical_transfer(k, half, 0.0, z)
 
 
 def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                            medium: Medium, band_limit: bool, dtype: np.dtype,
-                           conjugate: bool, compensate_loss: float | None) -> np.ndarray:
+                           conjugate: bool, compensate_loss: float | None,
+                           monostatic: bool = False) -> np.ndarray:
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
-    U = medium.vertical_transfer(k, kappa2, z, 0.0)
+    if monostatic:
+        U = two_way_transfer(k, medium, kappa2, z)
+    else:
+        U = medium.vertical_transfer(k, kappa2, z, 0.0)
     if band_limit:
         # Band-limited angular spectrum (Matsushima & Shimobaba 2009): the phase of U
         # is sampled every dp = 2*pi/(M*dx); a component whose lateral shift p*travel
         # exceeds half the FFT grid, M*dx/2, is aliased (it would wrap around), and
         # it cannot join a pixel and an element inside the grid anyway. Drop it.
+        # Round trip: the phase 2 sum kz_j(kappa/2) h_j shifts by (p/2) travel(kappa/2).
         ny, nx = shape
-        t = lateral_travel(k, medium, kappa2, z)
+        if monostatic:
+            t = 0.5 * lateral_travel(k, medium, kappa2 / 4, z)
+            evanescent = kappa2 > 4 * k * k
+        else:
+            t = lateral_travel(k, medium, kappa2, z)
+            evanescent = kappa2 > k * k
         with np.errstate(invalid="ignore"):  # 0 * inf at p = 0 for evanescent rows
             ok = ((np.abs(p[None, :]) * t <= nx * dx / 2)
                   & (np.abs(q[:, None]) * t <= ny * dy / 2))
-        U = np.where(ok | (kappa2 > k * k), U, 0)
+        U = np.where(ok | evanescent, U, 0)
     if conjugate and compensate_loss is not None:
         # Undo the absorption of the back-propagation where the component stands above
         # the noise (the adjoint's extra exp(-Im(kz) h) favours shallow planes).
-        U = U * absorption_gain(k, medium, kappa2, z, compensate_loss)
+        U = U * absorption_gain(k, medium, kappa2, z, compensate_loss, monostatic=monostatic)
     U = (U.conj() if conjugate else U).astype(dtype, copy=False)
     U.setflags(write=False)
     return U
@@ -253,14 +300,16 @@ class _PlaneOperator(ABC):
                  z: float | Sequence[float], medium: Medium | None = None,
                  pad: bool | float = True, dtype: type = np.complex128, *,
                  band_limit: bool = True, compensate_loss: bool = False,
-                 snr_db: float = DEFAULT_SNR_DB) -> None:
+                 snr_db: float = DEFAULT_SNR_DB, monostatic: bool = False) -> None:
         self.shape = (int(shape[0]), int(shape[1]))
         self.dx, self.dy, self.k = float(dx), float(dy), float(k)
         self.z = np.atleast_1d(np.asarray(z, dtype=float))
         self.medium = medium if medium is not None else _FREE
+        self.monostatic = bool(monostatic)
+        # The round trip halves the effective wavelength (wavenumber 2k).
+        lam = (np.pi if self.monostatic else 2 * np.pi) / self.k
         self.fft_shape = padded_shape(self.shape, pad, pitch=(self.dx, self.dy),
-                                      wavelength=2 * np.pi / self.k,
-                                      z_max=float(self.z.max(initial=0.0)))
+                                      wavelength=lam, z_max=float(self.z.max(initial=0.0)))
         self.dtype = np.dtype(dtype)
         self.band_limit = bool(band_limit)
         self.compensate_loss = bool(compensate_loss)
@@ -361,6 +410,9 @@ class AngularSpectrum(_PlaneOperator):
         adjoint.
     snr_db : float
         Signal-to-noise ratio of the data that limits that gain, dB (default 40).
+    monostatic : bool
+        A scanned transceiver's round trip (:func:`two_way_transfer`) instead of
+        the one-way transfer (default False).
 
     Examples
     --------
@@ -372,7 +424,8 @@ class AngularSpectrum(_PlaneOperator):
 
     def _transfer(self, z: float, conjugate: bool = False) -> np.ndarray:
         return _angular_transfer(self.fft_shape, self.dx, self.dy, self.k, z, self.medium,
-                                 self.band_limit, self.dtype, conjugate, self._gain_key)
+                                 self.band_limit, self.dtype, conjugate, self._gain_key,
+                                 self.monostatic)
 
 
 class Fresnel(_PlaneOperator):
@@ -395,16 +448,23 @@ class Fresnel(_PlaneOperator):
         ox = np.fft.fftfreq(Mx, 1.0 / Mx) * self.dx
         oy = np.fft.fftfreq(My, 1.0 / My) * self.dy
         L = self.medium.apparent_distance(z)
-        T0 = complex(self.medium.vertical_transfer(self.k, np.array(0.0), z, 0.0))
+        zero = np.array(0.0)
+        if self.monostatic:  # round trip: wavenumber 2k, both legs' transmissions
+            T0 = complex(two_way_transfer(self.k, self.medium, zero, z))
+            k = 2 * self.k
+        else:
+            T0 = complex(self.medium.vertical_transfer(self.k, zero, z, 0.0))
+            k = self.k
         if conjugate and self.compensate_loss:
-            T0 *= float(absorption_gain(self.k, self.medium, np.array(0.0), z, self.snr_db))
+            T0 *= float(absorption_gain(self.k, self.medium, zero, z, self.snr_db,
+                                        monostatic=self.monostatic))
         r2 = oy[:, None] ** 2 + ox[None, :] ** 2
-        kern = (T0 * self.k / (2j * np.pi * L) * np.exp(1j * self.k * r2 / (2 * L))
+        kern = (T0 * k / (2j * np.pi * L) * np.exp(1j * k * r2 / (2 * L))
                 * self.dx * self.dy)
         # The chirp's local frequency k*|x|/L must stay below the grid's Nyquist
         # pi/dx; beyond it the sampled kernel aliases, so it is cut there (the
         # sampling limit of the impulse-response method).
-        kern = np.where((np.abs(ox[None, :]) * self.k / L <= np.pi / self.dx)
-                        & (np.abs(oy[:, None]) * self.k / L <= np.pi / self.dy), kern, 0)
+        kern = np.where((np.abs(ox[None, :]) * k / L <= np.pi / self.dx)
+                        & (np.abs(oy[:, None]) * k / L <= np.pi / self.dy), kern, 0)
         U = sfft.fft2(kern, workers=-1)
         return (U.conj() if conjugate else U).astype(self.dtype, copy=False)

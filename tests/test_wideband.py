@@ -1,0 +1,114 @@
+"""Wideband and scanned-transceiver (monostatic) holograms: frequency axis, round trip.
+
+A point target of a monostatic scan returns a * G(r, r_t)^2 (simulate, exact layered
+Green's function). The exact per-frequency sum (migrate) must put it at its 3-D
+position, with the range resolution c/(2 B Re n) of holoradar.theory.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from holoradar.analysis.metrics import main_lobe_width, peak_position
+
+FREQS = np.linspace(8e9, 12e9, 11)  # 4 GHz in 400 MHz steps: unambiguous 37 cm in air
+
+
+@pytest.mark.parametrize("eps", [1.0, 2.5, 6.0])
+def test_monostatic_point_is_found_in_3d_with_the_range_resolution(eps):
+    # 40 x 40 scan at 6.2 mm (lambda_min/4 = 6.2 mm at 12 GHz: unaliased). The bound on
+    # position is a quarter of the resolution cell: laterally lambda_c L/(2 A) (the round
+    # trip halves lambda z/A), in range c/(2 B Re n)/4. The range response's first null
+    # (half main lobe) must be within 15% of c/(2 B Re n): the band's discrete sampling
+    # (11 frequencies: c/(2 n N df) is 9% below c/(2 n B)) and the spread of the
+    # aperture's angles (the range cell grows as 1/cos(theta)) move it by several %.
+    medium = hr.Medium.free_space() if eps == 1.0 else hr.Medium.half_space(0.15, eps)
+    target = (0.012, -0.007, 0.25)
+    ap = hr.Aperture.grid(40, 0.0062, monostatic=True)
+    h = hr.simulate(hr.Scene(medium, targets=[hr.PointTarget(target)]), ap, FREQS)
+    assert h.monostatic and h.data.shape == (11, 40, 40)
+    zs = np.linspace(0.21, 0.29, 81)
+    img = hr.migrate(h, zs, medium=None if eps == 1.0 else medium, upsample=2)
+    x, y, z = peak_position(img)
+    res = hr.theory.range_resolution(4e9, eps)
+    lam_c = hr.C0 / 10e9
+    cell = lam_c * medium.apparent_distance(target[2]) / (2 * 40 * 0.0062)
+    assert np.hypot(x - target[0], y - target[1]) < cell / 4
+    assert abs(z - target[2]) < res / 4
+    prof = np.abs(img.data[:, np.argmin(abs(img.y - y)), np.argmin(abs(img.x - x))])
+    assert abs(main_lobe_width(prof, zs) / 2 / res - 1) < 0.15
+
+
+def test_a_single_frequency_has_no_range_resolution():
+    # Sanity of the combination: the same scan at one frequency focuses in range only
+    # through the aperture (depth of focus ~ lambda (L/A)^2), far wider than the band's.
+    ap = hr.Aperture.grid(40, 0.0062, monostatic=True)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.25))]), ap, FREQS)
+    zs = np.linspace(0.15, 0.35, 81)
+    wide = np.abs(hr.migrate(h, zs).data).max(axis=(1, 2))
+    mono = np.abs(hr.migrate(h.at_frequency(5), zs).data).max(axis=(1, 2))
+    assert main_lobe_width(wide, zs) < 0.5 * main_lobe_width(mono, zs)
+
+
+def test_combine_options_and_equalisation():
+    ap = hr.Aperture.grid(16, 0.0062, monostatic=True)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.2))]), ap, FREQS)
+    kept = hr.migrate(h, [0.19, 0.2], combine="none")
+    assert kept.data.shape == (11, 2, 16, 16)
+    coh = hr.migrate(h, [0.19, 0.2], equalize=False)
+    raw = hr.migrate(h, [0.19, 0.2], combine="none", equalize=False).data
+    np.testing.assert_allclose(coh.data, raw.sum(axis=0), rtol=1e-12)
+    inc = hr.migrate(h, 0.2, combine="incoherent", equalize=False)
+    parts = hr.migrate(h, 0.2, combine="none", equalize=False).data
+    np.testing.assert_allclose(inc.data, np.sqrt((np.abs(parts) ** 2).sum(axis=0)), rtol=1e-12)
+    # equalize=True: each frequency's hologram scaled to unit RMS
+    eq = hr.migrate(h, 0.2, combine="none").data
+    rms = np.sqrt(np.mean(np.abs(h.data) ** 2, axis=(1, 2)))
+    np.testing.assert_allclose(eq, parts / rms[:, None, None], rtol=1e-12)
+    with pytest.raises(ValueError, match="equalize must be"):
+        hr.migrate(h, 0.2, equalize=[1.0, 2.0])
+    with pytest.raises(ValueError, match="combine must be"):
+        hr.migrate(h, 0.2, combine="sum")
+
+
+def test_array_geometry_frequencies_add_after_the_incident_phase():
+    # A receiver array lit by a plane wave: each frequency's image carries the incident
+    # phase exp(i k z) at the target; with the source known it is removed and the
+    # coherent sum focuses in range at the target (within a quarter of c/(2B)).
+    # Without a source a normal plane wave is assumed, with a warning.
+    ap = hr.Aperture.grid(40, 0.0124)
+    target = (0.0, 0.0, 0.25)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget(target)]), ap, FREQS)
+    assert h.source is not None and not h.monostatic
+    zs = np.linspace(0.21, 0.29, 81)
+    img = hr.migrate(h, zs, upsample=2)
+    assert abs(peak_position(img)[2] - target[2]) < hr.theory.range_resolution(
+        4e9, monostatic=False) / 4
+    with pytest.warns(hr.IlluminationWarning, match="plane wave at normal incidence"):
+        hr.migrate(h.replace(source=None), 0.25)
+
+
+def test_wideband_bad_input():
+    x = np.arange(8) * 0.005
+    with pytest.raises(ValueError, match="frequency axis third from last"):
+        hr.Hologram(np.zeros((3, 8, 8)), x, x, [9e9, 10e9])
+    with pytest.raises(ValueError, match="strictly increasing"):
+        hr.Hologram(np.zeros((2, 8, 8)), x, x, [10e9, 9e9])
+    with pytest.raises(ValueError, match="has no separate source"):
+        hr.Hologram(np.zeros((8, 8)), x, x, 9e9, source=hr.PlaneWave(), monostatic=True)
+    w = hr.Hologram(np.zeros((2, 8, 8)), x, x, [9e9, 10e9])
+    with pytest.raises(ValueError, match="has 2 frequencies"):
+        _ = w.k
+    with pytest.raises(ValueError, match="planar targets are not modelled"):
+        hr.simulate(hr.Scene(targets=[hr.PlanarTarget.from_shape("disk", 0.3, diameter=0.05)]),
+                    hr.Aperture.grid(8, 0.005, monostatic=True), 9e9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        # a transceiver at lambda/4 pitch is not aliased; at lambda/2 it is
+        with pytest.raises(hr.AliasingWarning, match="lambda/4"):
+            hr.migrate(hr.Hologram(np.ones((8, 8)), x * 2.4, x * 2.4, 12e9, monostatic=True),
+                       0.2)
