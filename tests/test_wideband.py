@@ -112,3 +112,24 @@ def test_wideband_bad_input():
         with pytest.raises(hr.AliasingWarning, match="lambda/4"):
             hr.migrate(hr.Hologram(np.ones((8, 8)), x * 2.4, x * 2.4, 12e9, monostatic=True),
                        0.2)
+
+
+def test_measured_data_habits():
+    # A scan whose device adds a DC offset per frequency, a phase response, and I - iQ.
+    ap = hr.Aperture.grid(24, 0.0062, monostatic=True)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.01, 0.0, 0.2))]), ap, FREQS)
+    phase = 0.3 + 2e-9 * (FREQS - 8e9)  # a linear phase response: 8 rad over the band
+    offset = (0.5 + 0.2j) * np.abs(h.data).max()
+    recorded = hr.conjugate(h.with_data((h.data + offset) * np.exp(1j * phase)[:, None, None]))
+    zs = [0.18, 0.2, 0.22]
+    assert hr.iq_convention(recorded, zs) == "I-iQ"
+    fixed = hr.conjugate(recorded)
+    table_f = np.linspace(7.5e9, 12.5e9, 41)
+    calibrated = hr.apply_calibration(fixed, table_f, 0.3 + 2e-9 * (table_f - 8e9))
+    np.testing.assert_allclose(calibrated.data, h.data + offset, rtol=1e-9, atol=1e-12)
+    clean = hr.remove_mean(calibrated)
+    np.testing.assert_allclose(clean.data.mean(axis=(1, 2)), 0, atol=1e-12)
+    np.testing.assert_allclose(clean.data, hr.remove_mean(h).data, rtol=1e-9, atol=1e-12)
+    assert hr.iq_convention(clean, zs) == "I+iQ"
+    with pytest.raises(ValueError, match="must cover every frequency"):
+        hr.apply_calibration(fixed, np.linspace(9e9, 12e9, 5), np.zeros(5))

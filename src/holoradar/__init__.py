@@ -17,6 +17,8 @@ Examples
 from . import theory
 from ._validate import AliasingWarning
 from .data.hologram import C0, Hologram, Image
+from .data.wideband import apply_calibration, conjugate, remove_mean
+from .imaging.iq import iq_convention
 from .imaging.migrate import IlluminationWarning, migrate
 from .imaging.reflection import (
     FitWarning,
@@ -56,9 +58,13 @@ __all__ = [
     "SuppressionReport",
     "__version__",
     "align_phases",
+    "apply_calibration",
+    "conjugate",
     "estimate_permittivity",
+    "iq_convention",
     "migrate",
     "permittivity",
+    "remove_mean",
     "simulate",
     "suppress_surface",
     "synthesize",
