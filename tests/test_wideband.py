@@ -59,7 +59,7 @@ def test_combine_options_and_equalisation():
     h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.2))]), ap, FREQS)
     kept = hr.migrate(h, [0.19, 0.2], combine="none")
     assert kept.data.shape == (11, 2, 16, 16)
-    coh = hr.migrate(h, [0.19, 0.2], equalize=False)
+    coh = hr.migrate(h, [0.19, 0.2], equalize=False, algorithm="frequency")
     raw = hr.migrate(h, [0.19, 0.2], combine="none", equalize=False).data
     np.testing.assert_allclose(coh.data, raw.sum(axis=0), rtol=1e-12)
     inc = hr.migrate(h, 0.2, combine="incoherent", equalize=False)
@@ -133,3 +133,26 @@ def test_measured_data_habits():
     assert hr.iq_convention(clean, zs) == "I+iQ"
     with pytest.raises(ValueError, match="must cover every frequency"):
         hr.apply_calibration(fixed, np.linspace(9e9, 12e9, 5), np.zeros(5))
+
+
+@pytest.mark.parametrize(("geometry", "medium"), [
+    ("monostatic", hr.Medium.free_space()), ("monostatic", hr.Medium.half_space(0.15, 2.5)),
+    ("monostatic", hr.Medium.layered([0.10, 0.13], [5.0, 8.0])),
+    ("array", hr.Medium.half_space(0.15, 2.5))])
+def test_wavenumber_domain_sum_equals_the_per_frequency_sum(geometry, medium):
+    # The same coherent sum computed two ways: frequency by frequency (angular spectrum,
+    # one inverse FFT per frequency and plane) and carried from plane to plane in the
+    # wavenumber domain (one per plane). On the same FFT grid (pad=3) they are the same
+    # sum, term by term, so only rounding separates them: relative difference < 1e-10
+    # (measured ~5e-14).
+    mono = geometry == "monostatic"
+    ap = hr.Aperture.grid(24, 0.0062 if mono else 0.0124, monostatic=mono)
+    h = hr.simulate(hr.Scene(medium, targets=[hr.PointTarget((0.01, 0.0, 0.25))]), ap, FREQS,
+                    include_surface=False)
+    zs = np.linspace(0.16, 0.30, 29)
+    med = None if medium.is_free_space else medium
+    a = hr.migrate(h, zs, medium=med, algorithm="kspace", pad=3.0, upsample=2)
+    b = hr.migrate(h, zs, medium=med, algorithm="frequency", pad=3.0, upsample=2)
+    assert np.linalg.norm(a.data - b.data) < 1e-10 * np.linalg.norm(b.data)
+    with pytest.raises(ValueError, match="algorithm='kspace' needs"):
+        hr.migrate(h, [0.2, 0.21, 0.23], medium=med, algorithm="kspace")

@@ -26,6 +26,7 @@ from ..data.hologram import C0, Hologram, Image
 from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
 from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel
+from . import kspace
 
 __all__ = ["IlluminationWarning", "migrate"]
 
@@ -39,7 +40,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
             snr_db: float | None = None, fov: Literal["aperture", "full"] = "aperture",
             dtype: type | None = None, progress: bool | None = None,
             combine: Literal["coherent", "incoherent", "none"] = "coherent",
-            equalize: bool | Sequence[float] | np.ndarray = True) -> Image:
+            equalize: bool | Sequence[float] | np.ndarray = True,
+            algorithm: Literal["auto", "kspace", "frequency"] = "auto") -> Image:
     """Back-propagate a hologram to the planes at range ``z``.
 
     Parameters
@@ -109,6 +111,15 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         frequency's hologram to unit RMS (the paper's equalising factor: the
         device's response varies across the band); False keeps the recorded
         amplitudes; an array gives nf weights.
+    algorithm : {"auto", "kspace", "frequency"}
+        Several frequencies: ``"frequency"`` sums the per-frequency angular-spectrum
+        migrations; ``"kspace"`` carries the coherent sum from plane to plane in the
+        wavenumber domain (one inverse FFT per plane instead of one per frequency
+        and plane; the same result to rounding), which needs uniformly spaced
+        planes in the deepest region, ``fov="aperture"``, ``combine="coherent"``, a
+        transceiver or a normal plane wave, and no loss to compensate
+        (:mod:`holoradar.imaging.kspace`). ``"auto"`` (default) takes ``"kspace"``
+        where it applies.
     Returns
     -------
     Image
@@ -143,7 +154,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         return _migrate_wideband(hologram, z, medium=medium, method=method, pad=pad,
                                  upsample=upsample, compensate_loss=compensate_loss,
                                  snr_db=snr_db, fov=fov, dtype=dtype, progress=progress,
-                                 combine=combine, equalize=equalize)
+                                 combine=combine, equalize=equalize, algorithm=algorithm)
     zs = check_nonnegative_ranges(z, "z")
     scalar = np.ndim(z) == 0
     if method not in ("angular", "fresnel"):
@@ -236,7 +247,7 @@ def _weights(hologram: Hologram, equalize: Any) -> np.ndarray:
 
 
 def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any,
-                      medium: Medium | None, **kw: Any) -> Image:
+                      medium: Medium | None, algorithm: str = "auto", **kw: Any) -> Image:
     """The exact per-frequency sum: each frequency migrated, phased, weighted, combined."""
     if combine not in ("coherent", "incoherent", "none"):
         raise ValueError(f"combine must be 'coherent', 'incoherent' or 'none', got {combine!r}")
@@ -251,6 +262,25 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
                       "source for the true one", IlluminationWarning, stacklevel=3)
     warn_if_aliased(max(hologram.pitch), C0 / hologram.frequencies[-1], "hologram",
                     round_trip=hologram.monostatic)
+    if algorithm not in ("auto", "kspace", "frequency"):
+        raise ValueError(f"algorithm must be 'auto', 'kspace' or 'frequency', got {algorithm!r}")
+    if algorithm != "frequency" and medium is not None and not isinstance(medium, Medium):
+        raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
+    zs_all = check_nonnegative_ranges(z, "z")
+    fast = kspace.applicable(hologram, zs_all, med, method=kw.get("method", "angular"),
+                             fov=kw.get("fov", "aperture"), combine=combine,
+                             compensate_loss=kw.get("compensate_loss", True))
+    if algorithm == "kspace" and not fast:
+        raise ValueError("algorithm='kspace' needs uniformly spaced planes in the deepest "
+                         "region, fov='aperture', combine='coherent', a transceiver or a "
+                         "normal plane wave, and no loss to compensate; use 'auto'")
+    if fast and algorithm != "frequency":
+        img = kspace.migrate_kspace(hologram, zs_all, med, w, pad=kw.get("pad", True),
+                                    upsample=kw.get("upsample", 1), dtype=kw.get("dtype"))
+        if np.ndim(z) == 0:
+            return Image(img.data[..., 0, :, :], img.x, img.y, img.z, img.frequency,
+                         img.method, has_z_axis=False)
+        return img
     acc: np.ndarray | None = None
     parts = []
     img = None
