@@ -23,7 +23,7 @@ from tqdm.auto import tqdm
 from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
 from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
-from ..physics.incident import incident_on_plane
+from ..physics.incident import incident_on_planes
 from ..physics.medium import Medium
 from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel
 from . import kspace
@@ -310,18 +310,15 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
 
 
 def _incident_phasor(source: Any, k: float, medium: Medium, img: Image) -> np.ndarray:
-    """``conj(E0)/|E0|`` on every image plane (nz, ny, nx); E0 = exp(i kz0...) at normal
+    """``conj(E0)/|E0|`` on every image plane (nz, ny, nx); E0 = the transfer at normal
     incidence without a source."""
-    out = np.empty((img.z.size, img.y.size, img.x.size), complex)
-    for j, zj in enumerate(img.z):
-        if source is None:
-            e0 = np.full((img.y.size, img.x.size), complex(
-                medium.vertical_transfer(k, np.array(0.0), 0.0, float(zj))))
-        else:
-            e0 = incident_on_plane(source, k, medium, img.x, img.y, float(zj))
-        mag = np.abs(e0)
-        out[j] = np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
-    return out
+    if source is None:
+        e0 = np.array([complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zj)))
+                       for zj in img.z])[:, None, None] * np.ones((1, img.y.size, img.x.size))
+    else:
+        e0 = incident_on_planes(source, k, medium, img.x, img.y, img.z)
+    mag = np.abs(e0)
+    return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
 
 
 def _data_snr(hologram: Hologram, medium: Medium | None, zs: np.ndarray) -> float:

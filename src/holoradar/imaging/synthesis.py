@@ -33,7 +33,7 @@ from typing import Literal
 import numpy as np
 
 from ..data.hologram import Hologram, Image
-from ..physics.incident import incident_on_plane
+from ..physics.incident import incident_on_planes
 from ..physics.medium import Medium
 from .migrate import migrate
 
@@ -171,12 +171,10 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     k = views[0].k
     aligned = np.empty_like(g)
     for i, v in enumerate(views):
-        for j, zj in enumerate(img.z):
-            e0 = incident_on_plane(v.source, k, med, img.x, img.y, float(zj))
-            mag = np.abs(e0)
-            # conj(E0)/|E0|: the unit phasor of the incident field (0 where it vanishes)
-            phasor = np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
-            aligned[i, j] = g[i, j] * phasor
+        e0 = incident_on_planes(v.source, k, med, img.x, img.y, img.z)
+        mag = np.abs(e0)
+        # conj(E0)/|E0|: the unit phasor of the incident field (0 where it vanishes)
+        aligned[i] = g[i] * np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
     if mode == "coherent":
         total = aligned.sum(axis=0)
     elif mode == "amplitude":
