@@ -113,7 +113,11 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
             jmax = np.floor((room - t0) / (rate * dz))
         jmax = np.where(evanescent, nz, np.nan_to_num(jmax, nan=nz, posinf=nz, neginf=-1))
         steps.append(step.astype(work))
-        drops.append([np.nonzero(jmax == j) for j in range(nz)])
+        # Flat indices of the components leaving after plane j: drop[j] = order[b[j]:b[j+1]].
+        flat = jmax.ravel()
+        order = np.argsort(flat, kind="stable")
+        bounds = np.searchsorted(flat[order], np.arange(nz + 1), side="left")
+        drops.append((order, bounds))
         H[..., i, :, :] *= a.astype(work)
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
@@ -126,9 +130,10 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
             prod[..., j - c0, :, :] = H.sum(axis=-3)
             for i in range(hologram.nf):
                 H[..., i, :, :] *= steps[i]
-                idx = drops[i][j]
-                if idx[0].size:
-                    H[..., i, idx[0], idx[1]] = 0  # leaves the grid from the next plane on
+                order, bounds = drops[i]
+                idx = order[bounds[j]:bounds[j + 1]]
+                if idx.size:  # these leave the grid from the next plane on
+                    H[..., i, :, :].reshape((*batch, -1))[..., idx] = 0
         if u > 1:
             prod = _zero_pad_spectrum(prod, u)
         planes = sfft.ifft2(prod, axes=(-2, -1), workers=workers, overwrite_x=True)
