@@ -39,7 +39,7 @@ def _edges(c: np.ndarray) -> np.ndarray:
 
 
 def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:
-    """Amplitude and phase of a hologram (x, y in cm)."""
+    """Amplitude and phase of a hologram (x, y in cm); its first frame and frequency."""
     fig = Figure(figsize=(10, 4.3), layout="constrained")
     data = h.data.reshape((-1, *h.data.shape[-2:]))[0]
     for ax, val, lab, cmap in zip(fig.subplots(1, 2),
@@ -52,8 +52,11 @@ def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:
         ax.set_ylabel("y (cm)")
         ax.set_title(f"{title}: {'amplitude' if 'E' in lab else 'phase'}")
         fig.colorbar(m, ax=ax, label=lab)
-    fig.suptitle(f"{h.data.shape[-1]} x {h.data.shape[-2]} elements, "
-                 f"f = {h.frequency / 1e9:.3g} GHz")
+    f = h.frequencies
+    band = (f"f = {f[0] / 1e9:.3g} GHz" if f.size == 1 else
+            f"f = {f[0] / 1e9:.3g} GHz (first of {f.size}, to {f[-1] / 1e9:.3g} GHz)")
+    fig.suptitle(f"{h.data.shape[-1]} x {h.data.shape[-2]} elements, {band}"
+                 + (", scanned transceiver" if h.monostatic else ""))
     return fig
 
 
