@@ -160,7 +160,7 @@ def test_synthesis_through_the_ground_focuses_a_buried_point():
 def test_synthesis_bad_input():
     views, _ = _tiled_views(n=9)
     other_f = hr.Hologram(views[1].data, views[1].x, views[1].y, 10e9, source=views[1].source)
-    with pytest.raises(ValueError, match="views must share one frequency"):
+    with pytest.raises(ValueError, match="views must share their frequencies"):
         hr.synthesize([views[0], other_f], 1.0)
     other_grid = hr.Hologram(views[1].data, views[1].x + 0.001, views[1].y, F0,
                              source=views[1].source)

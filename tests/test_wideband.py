@@ -177,3 +177,22 @@ def test_monostatic_loss_compensation_keeps_the_range():
             peaks[name, comp] = peak_position(img)[2]
     res = hr.theory.range_resolution(4e9, eps)
     assert abs(peaks["lossy", True] - peaks["lossless", True]) < res / 10
+
+
+def test_wideband_views_synthesise():
+    # Two receiver-array views lit by plane waves at -+15 degrees, 11 frequencies each:
+    # every frequency's incident phase is removed per view, so views and frequencies
+    # all add in phase at the point (3-D position within a quarter of the cells).
+    ap = hr.Aperture.grid(32, 0.0124)
+    target = (0.01, -0.005, 0.25)
+    views = [hr.simulate(hr.Scene(source=hr.PlaneWave(a, 0.0), targets=[hr.PointTarget(target)]),
+                         ap, FREQS) for a in np.radians([-15, 15])]
+    zs = np.linspace(0.22, 0.28, 25)
+    img = hr.synthesize(views, zs, upsample=2)
+    x, y, z = peak_position(img)
+    cell = hr.C0 / 10e9 * 0.25 / (32 * 0.0124)
+    assert np.hypot(x - target[0], y - target[1]) < cell / 4
+    assert abs(z - target[2]) < hr.theory.range_resolution(4e9, monostatic=False) / 4
+    other = views[1].replace(data=views[1].data[:10], frequency=FREQS[:10])
+    with pytest.raises(ValueError, match="views must share their frequencies"):
+        hr.synthesize([views[0], other], zs)

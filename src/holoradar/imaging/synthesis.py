@@ -55,9 +55,10 @@ def _check_views(holograms: Sequence[Hologram]) -> list[Hologram]:
                              "illumination it was taken with (Hologram(..., source=...))")
     h0 = views[0]
     for i, h in enumerate(views[1:], start=1):
-        if not np.isclose(h.frequency, h0.frequency, rtol=1e-9, atol=0):
-            raise ValueError(f"holograms[{i}] is at {h.frequency} Hz but holograms[0] at "
-                             f"{h0.frequency} Hz: views must share one frequency")
+        if h.nf != h0.nf or not np.allclose(h.frequencies, h0.frequencies, rtol=1e-9, atol=0):
+            raise ValueError(f"holograms[{i}] has frequencies {h.frequencies} Hz but "
+                             f"holograms[0] {h0.frequencies} Hz: views must share their "
+                             "frequencies")
         if h.x.shape != h0.x.shape or h.y.shape != h0.y.shape or not (
                 np.allclose(h.x, h0.x) and np.allclose(h.y, h0.y)):
             raise ValueError(f"holograms[{i}] is sampled on another aperture grid than "
@@ -165,6 +166,13 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
         raise ValueError(f"mode must be 'coherent', 'amplitude' or 'quasi-coherent', got "
                          f"{mode!r}")
     med = medium if medium is not None else Medium.free_space()
+    if views[0].is_wideband:
+        # Each view's frequencies are summed coherently after their own incident phases
+        # (migrate does that with the view's source); the views then add as below.
+        imgs = [migrate(v, z, medium=medium, upsample=upsample, fov=fov) for v in views]
+        img = imgs[0]
+        aligned = np.stack([im.data if im.has_z_axis else im.data[None] for im in imgs])
+        return _combine(aligned, img, mode, return_views)
     stack = views[0].with_data(np.stack([v.data for v in views]))
     img = migrate(stack, z, medium=medium, upsample=upsample, fov=fov)
     g = img.data if img.has_z_axis else img.data[:, None]
@@ -175,6 +183,12 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
         mag = np.abs(e0)
         # conj(E0)/|E0|: the unit phasor of the incident field (0 where it vanishes)
         aligned[i] = g[i] * np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
+    return _combine(aligned, img, mode, return_views)
+
+
+def _combine(aligned: np.ndarray, img: Image, mode: str,
+             return_views: bool) -> Image | tuple[Image, np.ndarray]:
+    """Add the views, incident phase removed, (K, nz, ny, nx), as ``mode`` says."""
     if mode == "coherent":
         total = aligned.sum(axis=0)
     elif mode == "amplitude":
