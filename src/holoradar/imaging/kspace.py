@@ -43,8 +43,9 @@ _CHUNK = 8
 
 
 def applicable(hologram: Hologram, zs: np.ndarray, medium: Medium, *, method: str, fov: str,
-               combine: str, compensate_loss: bool) -> bool:
-    """Whether :func:`migrate_kspace` computes exactly what the per-frequency sum does."""
+               combine: str, compensate_loss: bool, phase_incident: bool = True) -> bool:
+    """Whether :func:`migrate_kspace` computes exactly what the per-frequency sum does
+    (``phase_incident=False``: what the plane-by-plane migration of each frequency does)."""
     if method != "angular" or fov != "aperture" or combine != "coherent" or zs.size < 2:
         return False
     steps = np.diff(zs)
@@ -56,14 +57,20 @@ def applicable(hologram: Hologram, zs: np.ndarray, medium: Medium, *, method: st
     if compensate_loss and any(complex(e).imag != 0 for e in medium.eps):
         return False
     src = hologram.source
-    if hologram.monostatic or src is None:
+    if hologram.monostatic or src is None or not phase_incident:
         return True
     return isinstance(src, PlaneWave) and src.alpha == 0 and src.beta == 0
 
 
 def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: np.ndarray, *,
-                   pad: Any = True, upsample: int = 1, dtype: Any = None) -> Image:
-    """The coherent wideband image on uniform planes ``zs`` (see the module docstring)."""
+                   pad: Any = True, upsample: int = 1, dtype: Any = None,
+                   phase_incident: bool = True) -> Image:
+    """The coherent wideband image on uniform planes ``zs`` (see the module docstring).
+
+    ``phase_incident=False`` leaves each frequency's incident phase in (for one
+    frequency: the plain back-propagated field, as :func:`holoradar.migrate`
+    returns it), and the data may lack the frequency axis.
+    """
     from .migrate import _zero_pad_spectrum
 
     mono = hologram.monostatic
@@ -76,7 +83,8 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
                              z_max=float(zs.max()))
     My, Mx = fft_shape
     workers = -1 if My * Mx >= 128 * 128 else 1
-    H = sfft.fft2(hologram.data.astype(work, copy=False), s=fft_shape, axes=(-2, -1),
+    data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
+    H = sfft.fft2(data.astype(work, copy=False), s=fft_shape, axes=(-2, -1),
                   workers=workers)                                   # (..., nf, My, Mx)
     p, q = spectral_axes(fft_shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2
@@ -100,10 +108,11 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
             t0 = lateral_travel(k, medium, kappa2, float(zs[0]))
             rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
             evanescent = kappa2 > k * k
-            e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zs[0])))
-            a = a * (np.conj(e0) / abs(e0))
+            if phase_incident:
+                e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zs[0])))
+                a = a * (np.conj(e0) / abs(e0))
         step = np.exp(-1j * np.conj(Kz) * dz)
-        if not mono:
+        if not mono and phase_incident:
             step = step * np.exp(-1j * (k * n_last).real * dz)
         # Band limit: the lateral shift |p| t(z), t(z) = t0 + (z - z0) * rate, must stay
         # within half the grid: the last plane index j a component may reach.
@@ -141,4 +150,6 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
             ..., :oy, :ox]
     x = hologram.x[0] + np.arange(ox) * dx / u
     y = hologram.y[0] + np.arange(oy) * dy / u
+    if not hologram.is_wideband:
+        return Image(out, x, y, zs, hologram.frequency, "angular")
     return Image(out, x, y, zs, hologram.frequencies.copy(), "kspace:coherent")

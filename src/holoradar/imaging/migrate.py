@@ -112,7 +112,11 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         device's response varies across the band); False keeps the recorded
         amplitudes; an array gives nf weights.
     algorithm : {"auto", "kspace", "frequency"}
-        Several frequencies: ``"frequency"`` sums the per-frequency angular-spectrum
+        One frequency: ``"frequency"`` builds the transfer function of every plane;
+        otherwise uniformly spaced planes in the deepest region (lossless, or
+        without loss compensation) are reached by one transfer and a phase step
+        from plane to plane (the same image). Several frequencies:
+        ``"frequency"`` sums the per-frequency angular-spectrum
         migrations; ``"kspace"`` carries the coherent sum from plane to plane in the
         wavenumber domain (one inverse FFT per plane instead of one per frequency
         and plane; the same result to rounding), which needs uniformly spaced
@@ -150,6 +154,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     """
     if not isinstance(hologram, Hologram):
         raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
+    if algorithm not in ("auto", "kspace", "frequency"):
+        raise ValueError(f"algorithm must be 'auto', 'kspace' or 'frequency', got {algorithm!r}")
     if hologram.is_wideband:
         return _migrate_wideband(hologram, z, medium=medium, method=method, pad=pad,
                                  upsample=upsample, compensate_loss=compensate_loss,
@@ -175,6 +181,15 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         np.complex64 if hologram.data.dtype == np.complex64 else np.complex128)
     if work not in (np.complex64, np.complex128):
         raise ValueError(f"dtype must be numpy.complex64 or numpy.complex128, got {dtype!r}")
+    med = medium if medium is not None else Medium.free_space()
+    if algorithm != "frequency" and np.size(zs) > 1 and kspace.applicable(
+            hologram, zs, med, method=method, fov=fov, combine="coherent",
+            compensate_loss=compensate_loss, phase_incident=False):
+        # Uniform planes in the deepest region: one transfer, then a phase step from
+        # plane to plane (the same result; no transfer function per plane to build).
+        img = kspace.migrate_kspace(hologram, zs, med, np.ones(1), pad=pad, upsample=upsample,
+                                    dtype=work, phase_incident=False)
+        return img
     cls = AngularSpectrum if method == "angular" else Fresnel
     if snr_db is None:
         snr_db = _data_snr(hologram, medium, zs) if compensate_loss else DEFAULT_SNR_DB
