@@ -25,7 +25,7 @@ from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
 from ..physics.incident import incident_on_planes
 from ..physics.medium import Medium
-from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel
+from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel, padded_shape
 from . import kspace
 
 __all__ = ["IlluminationWarning", "migrate"]
@@ -112,10 +112,11 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         device's response varies across the band); False keeps the recorded
         amplitudes; an array gives nf weights.
     algorithm : {"auto", "kspace", "frequency"}
-        One frequency: ``"frequency"`` builds the transfer function of every plane;
-        otherwise uniformly spaced planes in the deepest region (lossless, or
-        without loss compensation) are reached by one transfer and a phase step
-        from plane to plane (the same image). Several frequencies:
+        One frequency: ``"frequency"`` builds (and caches) the transfer function
+        of every plane; ``"kspace"`` reaches uniformly spaced planes in the
+        deepest region (lossless, or without loss compensation) by one transfer
+        and a phase step from plane to plane (the same image); ``"auto"`` takes
+        the latter when the planes' transfers would not fit in the cache. Several frequencies:
         ``"frequency"`` sums the per-frequency angular-spectrum
         migrations; ``"kspace"`` carries the coherent sum from plane to plane in the
         wavenumber domain (one inverse FFT per plane instead of one per frequency
@@ -182,11 +183,17 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     if work not in (np.complex64, np.complex128):
         raise ValueError(f"dtype must be numpy.complex64 or numpy.complex128, got {dtype!r}")
     med = medium if medium is not None else Medium.free_space()
-    if algorithm != "frequency" and np.size(zs) > 1 and kspace.applicable(
-            hologram, zs, med, method=method, fov=fov, combine="coherent",
-            compensate_loss=compensate_loss, phase_incident=False):
-        # Uniform planes in the deepest region: one transfer, then a phase step from
-        # plane to plane (the same result; no transfer function per plane to build).
+    stepping = algorithm != "frequency" and np.size(zs) > 1 and kspace.applicable(
+        hologram, zs, med, method=method, fov=fov, combine="coherent",
+        compensate_loss=compensate_loss, phase_incident=False)
+    if algorithm == "kspace" and not stepping:
+        raise ValueError("algorithm='kspace' needs several uniformly spaced planes in the "
+                         "deepest region, method='angular', fov='aperture' and no loss to "
+                         "compensate; use 'auto'")
+    if stepping and (algorithm == "kspace" or _too_big_to_cache(hologram, zs, pad, work)):
+        # Uniform planes in the deepest region whose transfer functions could not all be
+        # cached: one transfer, then a phase step from plane to plane (the same result;
+        # no transfer function per plane to build on every call).
         img = kspace.migrate_kspace(hologram, zs, med, np.ones(1), pad=pad, upsample=upsample,
                                     dtype=work, phase_incident=False)
         return img
@@ -334,6 +341,16 @@ def _incident_phasor(source: Any, k: float, medium: Medium, img: Image) -> np.nd
         e0 = incident_on_planes(source, k, medium, img.x, img.y, img.z)
     mag = np.abs(e0)
     return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
+
+
+def _too_big_to_cache(hologram: Hologram, zs: np.ndarray, pad: Any, work: np.dtype) -> bool:
+    """True when the planes' transfer functions would not fit in the transfer cache."""
+    from ..physics.propagation import _CACHE
+
+    lam = hologram.wavelength / (2 if hologram.monostatic else 1)
+    shape = padded_shape(hologram.data.shape[-2:], pad, pitch=hologram.pitch, wavelength=lam,
+                         z_max=float(zs.max()))
+    return zs.size * shape[0] * shape[1] * np.dtype(work).itemsize > _CACHE.max_bytes // 2
 
 
 def _data_snr(hologram: Hologram, medium: Medium | None, zs: np.ndarray) -> float:
