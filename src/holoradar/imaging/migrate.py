@@ -74,15 +74,16 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         In lossy layers, back-propagate each travelling component with its phase
         and transmissions but without a second absorption ``a = exp(-Im(kz)*h)``,
         as long as it stands above the noise; components attenuated below it are
-        weighted as in the matched filter: the filter is ``conj(U)*(1 + e)/(a + e)``
-        with ``e = 10^(-snr_db/20)``
+        weighted as in the matched filter: the filter is
+        ``conj(U) * (1/a0) * (1 + e)/(a/a0 + e)``, ``a0`` the vertical component's
+        absorption, ``e = 10^(-snr_db/20)``
         (:func:`~holoradar.physics.propagation.absorption_gain`). The plain
         adjoint (False) is the matched filter, best in SNR, but its extra decay
         with depth pulls the focus towards the surface, by
         ``~ k*Im(n) * (FWHM/2.355)^2`` for a depth response of width FWHM (6 mm in
         the paper's sand with its 16 x 16 array). The trade-off: the compensated
-        image's noise is at most ``10^(snr_db/20)`` times the adjoint's, never
-        above that of a lossless back-propagation, and its SNR in a plane stays
+        image's noise rises above the adjoint's by the absorption it undoes but
+        never above that of a lossless back-propagation, and its SNR in a plane stays
         within the bound of the tests (a fraction of a dB in clay). Default True.
         No effect in lossless media.
     snr_db : float, optional
@@ -116,8 +117,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         of every plane; ``"kspace"`` reaches uniformly spaced planes in the
         deepest region (lossless, or without loss compensation) by one transfer
         and a phase step from plane to plane (the same image); ``"auto"`` takes
-        the latter when the planes' transfers would not fit in the cache. Several frequencies:
-        ``"frequency"`` sums the per-frequency angular-spectrum
+        the latter when the planes' transfers would not fit in the cache.
+        Several frequencies: ``"frequency"`` sums the per-frequency angular-spectrum
         migrations; ``"kspace"`` carries the coherent sum from plane to plane in the
         wavenumber domain (one inverse FFT per plane instead of one per frequency
         and plane; the same result to rounding), which needs uniformly spaced
@@ -194,9 +195,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         # Uniform planes in the deepest region whose transfer functions could not all be
         # cached: one transfer, then a phase step from plane to plane (the same result;
         # no transfer function per plane to build on every call).
-        img = kspace.migrate_kspace(hologram, zs, med, np.ones(1), pad=pad, upsample=upsample,
-                                    dtype=work, phase_incident=False)
-        return img
+        return kspace.migrate_kspace(hologram, zs, med, np.ones(1), pad=pad, upsample=upsample,
+                                     dtype=work, phase_incident=False)
     cls = AngularSpectrum if method == "angular" else Fresnel
     if snr_db is None:
         snr_db = _data_snr(hologram, medium, zs) if compensate_loss else DEFAULT_SNR_DB
@@ -273,10 +273,12 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
     """The exact per-frequency sum: each frequency migrated, phased, weighted, combined."""
     if combine not in ("coherent", "incoherent", "none"):
         raise ValueError(f"combine must be 'coherent', 'incoherent' or 'none', got {combine!r}")
+    if medium is not None and not isinstance(medium, Medium):
+        raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
     w = _weights(hologram, equalize)
+    zs_all = check_nonnegative_ranges(z, "z")
     if kw.get("snr_db") is None and kw.get("compensate_loss", True):
-        zs = check_nonnegative_ranges(z, "z")
-        kw["snr_db"] = _data_snr(hologram, medium, zs)
+        kw["snr_db"] = _data_snr(hologram, medium, zs_all)
     med = medium if medium is not None else Medium.free_space()
     if not hologram.monostatic and hologram.source is None and combine == "coherent":
         warnings.warn("combining frequencies without hologram.source: a plane wave at normal "
@@ -284,11 +286,6 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
                       "source for the true one", IlluminationWarning, stacklevel=3)
     warn_if_aliased(max(hologram.pitch), C0 / hologram.frequencies[-1], "hologram",
                     round_trip=hologram.monostatic)
-    if algorithm not in ("auto", "kspace", "frequency"):
-        raise ValueError(f"algorithm must be 'auto', 'kspace' or 'frequency', got {algorithm!r}")
-    if algorithm != "frequency" and medium is not None and not isinstance(medium, Medium):
-        raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
-    zs_all = check_nonnegative_ranges(z, "z")
     fast = kspace.applicable(hologram, zs_all, med, method=kw.get("method", "angular"),
                              fov=kw.get("fov", "aperture"), combine=combine,
                              compensate_loss=kw.get("compensate_loss", True))

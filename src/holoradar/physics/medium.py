@@ -363,13 +363,13 @@ class Medium:
         R_up = np.zeros(np.shape(kz), complex)
         T_up = np.ones(np.shape(kz), complex)
         for m in range(1, region + 1):
-            r_m, t_m = fresnel(st.kzs[m], st.kzs[m - 1], self.eps[m], self.eps[m - 1],
-                               self.polarization)  # from region m up into m - 1
+            r_dn, t_dn = st.rt[m - 1]  # from m - 1 down into m
+            r_m = -r_dn                 # from m up into m - 1: r is odd, t = 1 + r
+            t_m = 1 + r_m
             if m == 1:
                 R_up, T_up = r_m, t_m
                 continue
             ph = np.exp(1j * st.kzs[m - 1] * self._thickness(m - 1))
-            r_dn, t_dn = st.rt[m - 1]  # from m - 1 down into m: r_dn = -r_m
             den = 1 - R_up * r_dn * ph * ph
             T_up = T_up * t_m * ph / den
             R_up = r_m + t_dn * t_m * R_up * ph * ph / den
