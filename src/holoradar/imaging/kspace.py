@@ -24,6 +24,7 @@ needed (lossless layers, or ``compensate_loss=False``). Otherwise
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -32,14 +33,16 @@ import scipy.fft as sfft
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import (
-    _angular_transfer,
+    _CACHE,
     lateral_travel,
     padded_shape,
-    spectral_axes,
+    two_way_transfer,
 )
 from ..physics.sources import PlaneWave
 
-_CHUNK = 8
+_CHUNK = 8      # planes per inverse-FFT batch (memory: _CHUNK padded planes)
+_BLOCK = 2048   # spectral components per cache block of the recurrence
+_TINY = 1e-17   # a component below this fraction of its frequency's largest is dropped
 
 
 def applicable(hologram: Hologram, zs: np.ndarray, medium: Medium, *, method: str, fov: str,
@@ -71,85 +74,248 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
     frequency: the plain back-propagated field, as :func:`holoradar.migrate`
     returns it), and the data may lack the frequency axis.
     """
-    from .migrate import _zero_pad_spectrum
-
     mono = hologram.monostatic
     dx, dy = hologram.pitch
     ny, nx = hologram.data.shape[-2:]
-    work = np.dtype(dtype) if dtype is not None else (
-        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128)
+    work = np.dtype(dtype if dtype is not None else (
+        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
     lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
     fft_shape = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam,
                              z_max=float(zs.max()))
     My, Mx = fft_shape
     workers = -1 if My * Mx >= 128 * 128 else 1
+    weights = np.asarray(weights, dtype=float)
+    key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in hologram.wavenumbers),
+           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, phase_incident,
+           work.str, tuple(weights != 0))
+    plan = _CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
     data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
-    H = sfft.fft2(data.astype(work, copy=False), s=fft_shape, axes=(-2, -1),
-                  workers=workers)                                   # (..., nf, My, Mx)
-    p, q = spectral_axes(fft_shape, dx, dy)
-    kappa2 = q[:, None] ** 2 + p[None, :] ** 2
-    last = medium.n_regions - 1
-    dz = float(zs[1] - zs[0])
-    n_last = medium.n(last)
-    nz = zs.size
-    steps = []
-    drops = []
-    for i, k in enumerate(hologram.wavenumbers):
-        Uc = _angular_transfer(fft_shape, dx, dy, float(k), float(zs[0]), medium, True, work,
-                               True, None, mono)
-        a = weights[i] * Uc
-        if mono:
-            Kz = 2 * medium.kz(k, kappa2 / 4, last)
-            t0 = 0.5 * lateral_travel(k, medium, kappa2 / 4, float(zs[0]))
-            rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
-            evanescent = kappa2 > 4 * k * k
-        else:
-            Kz = medium.kz(k, kappa2, last)
-            t0 = lateral_travel(k, medium, kappa2, float(zs[0]))
-            rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
-            evanescent = kappa2 > k * k
-            if phase_incident:
-                e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zs[0])))
-                a = a * (np.conj(e0) / abs(e0))
-        step = np.exp(-1j * np.conj(Kz) * dz)
-        if not mono and phase_incident:
-            step = step * np.exp(-1j * (k * n_last).real * dz)
-        # Band limit: the lateral shift |p| t(z), t(z) = t0 + (z - z0) * rate, must stay
-        # within half the grid: the last plane index j a component may reach.
-        with np.errstate(divide="ignore", invalid="ignore"):
-            room = np.minimum(np.where(p[None, :] != 0, Mx * dx / 2 / np.abs(p[None, :]), np.inf),
-                              np.where(q[:, None] != 0, My * dy / 2 / np.abs(q[:, None]), np.inf))
-            jmax = np.floor((room - t0) / (rate * dz))
-        jmax = np.where(evanescent, nz, np.nan_to_num(jmax, nan=nz, posinf=nz, neginf=-1))
-        steps.append(step.astype(work))
-        # Flat indices of the components leaving after plane j: drop[j] = order[b[j]:b[j+1]].
-        flat = jmax.ravel()
-        order = np.argsort(flat, kind="stable")
-        bounds = np.searchsorted(flat[order], np.arange(nz + 1), side="left")
-        drops.append((order, bounds))
-        H[..., i, :, :] *= a.astype(work)
+    batch = data.shape[:-3]
+    # Pruned forward FFT: along x over the recorded rows only, then along y.
+    H = sfft.fft(data.astype(work, copy=False), n=Mx, axis=-1, workers=workers)
+    H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
+    Hc = plan.gather(H.reshape((-1, plan.nf, My * Mx)), weights)
+    del H
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    batch = H.shape[:-3]
-    out = np.empty((*batch, nz, oy, ox), dtype=work)
-    for c0 in range(0, nz, _CHUNK):
-        c1 = min(nz, c0 + _CHUNK)
-        prod = np.empty((*batch, c1 - c0, My, Mx), dtype=work)
-        for j in range(c0, c1):
-            prod[..., j - c0, :, :] = H.sum(axis=-3)
-            for i in range(hologram.nf):
-                H[..., i, :, :] *= steps[i]
-                order, bounds = drops[i]
-                idx = order[bounds[j]:bounds[j + 1]]
-                if idx.size:  # these leave the grid from the next plane on
-                    H[..., i, :, :].reshape((*batch, -1))[..., idx] = 0
-        if u > 1:
-            prod = _zero_pad_spectrum(prod, u)
-        planes = sfft.ifft2(prod, axes=(-2, -1), workers=workers, overwrite_x=True)
-        out[..., c0:c1, :, :] = planes[..., :oy, :ox] * (u * u) if u > 1 else planes[
-            ..., :oy, :ox]
+    out = np.empty((*batch, zs.size, oy, ox), dtype=work)
+    plan.sum_planes(Hc, out.reshape((-1, zs.size, oy, ox)), u, workers)
     x = hologram.x[0] + np.arange(ox) * dx / u
     y = hologram.y[0] + np.arange(oy) * dy / u
     if not hologram.is_wideband:
         return Image(out, x, y, zs, hologram.frequency, "angular")
     return Image(out, x, y, zs, hologram.frequencies.copy(), "kspace:coherent")
+
+
+@dataclass
+class _Plan:
+    """What a geometry needs, built once (cached with the transfer functions).
+
+    The components some frequency still needs, ordered by the last plane they
+    reach (so the live ones are a shrinking prefix) and stored block by block
+    (each block contiguous, so that the recurrence runs in cache); per frequency
+    their gain at the first plane and step to the next; and the drops: a
+    component of one frequency that leaves while its block goes on.
+    """
+
+    grid: tuple[int, int]
+    order: np.ndarray       # (n,) flat indices into the padded grid
+    gain: np.ndarray        # (nb, nf, _BLOCK) conj transfer to the first plane
+    step: np.ndarray        # (nb, nf, _BLOCK) plane-to-plane factor
+    block_end: np.ndarray   # (nb,) last plane any component of a block reaches
+    n_live: np.ndarray      # (nz,) live prefix at each chunk of planes
+    f_ev: np.ndarray        # drops (frequency, index in block), by (block, plane)
+    c_ev: np.ndarray
+    ptr: np.ndarray         # CSR pointers into the drops, block * (nz + 1) + plane
+    scatter: list           # per chunk: (live rows, index into a buffer of those rows)
+
+    @property
+    def nf(self) -> int:
+        return self.gain.shape[1]
+
+    @property
+    def nbytes(self) -> int:
+        return sum(a.nbytes for a in (self.order, self.gain, self.step, self.block_end,
+                                      self.n_live, self.f_ev, self.c_ev, self.ptr,
+                                      *(a for pair in self.scatter for a in pair)))
+
+    @classmethod
+    def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
+              z0: float, dz: float, nz: int, medium: Medium, mono: bool,
+              phase_incident: bool, work: np.dtype, used: np.ndarray) -> _Plan:
+        My, Mx = grid
+        # Everything depends on |p| and |q| only: compute on one quadrant of the
+        # spectrum and unfold (four times less work for a cold start).
+        ix, iy = np.arange(Mx), np.arange(My)
+        ix, iy = np.minimum(ix, Mx - ix), np.minimum(iy, My - iy)
+        p = 2 * np.pi * np.arange(ix.max() + 1) / (Mx * dx)
+        q = 2 * np.pi * np.arange(iy.max() + 1) / (My * dy)
+        unfold = (iy[:, None] * p.size + ix[None, :]).ravel()
+        kappa2 = q[:, None] ** 2 + p[None, :] ** 2
+        last = medium.n_regions - 1
+        n_last = medium.n(last)
+        nf = len(ks)
+        shape = (nf, p.size * q.size)
+        gain, step = np.empty(shape, dtype=work), np.empty(shape, dtype=work)
+        jmax = np.empty(shape, dtype=np.int32)
+        for i, k in enumerate(ks):
+            if mono:
+                a = np.conj(two_way_transfer(k, medium, kappa2, z0))
+                Kz = 2 * medium.kz(k, kappa2 / 4, last)
+                t0 = 0.5 * lateral_travel(k, medium, kappa2 / 4, z0)
+                evanescent = kappa2 > 4 * k * k
+            else:
+                a = np.conj(medium.vertical_transfer(k, kappa2, z0, 0.0))
+                Kz = medium.kz(k, kappa2, last)
+                t0 = lateral_travel(k, medium, kappa2, z0)
+                evanescent = kappa2 > k * k
+                if phase_incident:
+                    e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, z0))
+                    a = a * (np.conj(e0) / abs(e0))
+            rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
+            s = np.exp(-1j * np.conj(Kz) * dz)
+            if not mono and phase_incident:
+                s = s * np.exp(-1j * (k * n_last).real * dz)
+            gain[i], step[i] = a.ravel(), s.ravel()
+            # The band limit at the first plane (jmax < 0) is the per-plane one.
+            jmax[i] = _last_planes(a, s, evanescent, p, q, t0, rate, dz, grid, (dx, dy),
+                                   nz).ravel() if used[i] else -1
+        jmax = jmax[:, unfold]
+        reach = jmax.max(axis=0)
+        live = np.flatnonzero(reach >= 0)
+        # Live ones first, chunk of planes by chunk (a prefix for each chunk), in grid
+        # order within a chunk (the scatter into the grid then runs forwards).
+        order = live[np.argsort((-(reach[live] // _CHUNK)).astype(_small_int(nz)),
+                                kind="stable")]   # a radix sort on small integers
+        reach, jm = reach[order], jmax[:, order]
+        del jmax
+        n = order.size
+        nb = -(-n // _BLOCK)
+        blocked = np.zeros(nb * _BLOCK, dtype=np.intp)
+        blocked[:n] = unfold[order]
+        gain, step = gain[:, blocked], step[:, blocked]
+        gain[:, :n][jm < 0] = 0              # a frequency that never needs it
+        gain[:, n:] = 0
+        gain = np.ascontiguousarray(gain.reshape(nf, nb, _BLOCK).transpose(1, 0, 2))
+        step = np.ascontiguousarray(step.reshape(nf, nb, _BLOCK).transpose(1, 0, 2))
+        cls_ = reach // _CHUNK
+        n_live = np.searchsorted(-cls_, -(np.arange(nz) // _CHUNK), side="right")
+        block_end = np.maximum.reduceat(reach, np.arange(0, n, _BLOCK)) if n else reach
+        f_ev, c_ev = np.nonzero((jm >= 0) & (jm < np.repeat(block_end, _BLOCK)[:n]))
+        key = (c_ev // _BLOCK) * (nz + 1) + jm[f_ev, c_ev]
+        srt = np.argsort(key.astype(_small_int(nb * (nz + 1))), kind="stable")
+        ptr = np.searchsorted(key[srt], np.arange(nb * (nz + 1) + 1))
+        # Where each chunk's live components go in its inverse FFT's buffer of live rows.
+        scatter = []
+        for c0 in range(0, nz, _CHUNK):
+            m = min(n, -(-int(n_live[c0]) // _BLOCK) * _BLOCK)
+            rows = order[:m] // Mx
+            used = np.unique(rows)
+            scatter.append((used, np.searchsorted(used, rows) * Mx + order[:m] % Mx))
+        plan = cls(grid, order, gain, step, block_end, n_live, f_ev[srt].astype(np.intp),
+                   (c_ev[srt] % _BLOCK).astype(np.intp), ptr, scatter)
+        for arr in (plan.order, plan.gain, plan.step, plan.block_end, plan.n_live, plan.f_ev,
+                    plan.c_ev, plan.ptr, *(a for pair in scatter for a in pair)):
+            arr.setflags(write=False)
+        return plan
+
+    def gather(self, H: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """The live components of spectra ``H`` (``(B, nf, My*Mx)``), weighted and
+        taken to the first plane, block by block: ``(nb, B, nf, _BLOCK)``."""
+        nb = self.gain.shape[0]
+        idx = np.zeros(nb * _BLOCK, dtype=np.intp)
+        idx[:self.order.size] = self.order
+        Hc = H[:, :, idx].reshape((H.shape[0], self.nf, nb, _BLOCK)).transpose(2, 0, 1, 3)
+        Hc = np.ascontiguousarray(Hc)
+        Hc *= self.gain[:, None] * weights[None, None, :, None].astype(Hc.dtype)
+        return Hc
+
+    def sum_planes(self, Hc: np.ndarray, out: np.ndarray, u: int, workers: int) -> None:
+        """``out[b, j] = crop(ifft2(sum_f H[b, f] step[f]^j))`` with the drops.
+
+        The recurrence runs block by block through a chunk of planes, each block's
+        data and steps contiguous and in cache. ``Hc`` (from :meth:`gather`) is
+        consumed.
+        """
+        from .migrate import _zero_pad_spectrum
+
+        B = Hc.shape[1]
+        nz, oy, ox = out.shape[-3:]
+        size = self.order.size
+        for c0 in range(0, nz, _CHUNK):
+            c1 = min(nz, c0 + _CHUNK)
+            # Whole blocks: a live block's tail (already zeroed by its drops) comes along.
+            n_blocks = -(-int(self.n_live[c0]) // _BLOCK)
+            spec = np.empty((B, c1 - c0, n_blocks * _BLOCK), dtype=Hc.dtype)
+            for b in range(n_blocks):
+                s0, s1 = b * _BLOCK, (b + 1) * _BLOCK
+                hb, sb = Hc[b], self.step[b]
+                j1 = min(c1, int(self.block_end[b]) + 1)
+                for j in range(c0, j1):
+                    np.sum(hb, axis=1, out=spec[:, j - c0, s0:s1])
+                    hb *= sb
+                    e0, e1 = self.ptr[b * (nz + 1) + j], self.ptr[b * (nz + 1) + j + 1]
+                    if e1 > e0:
+                        hb[:, self.f_ev[e0:e1], self.c_ev[e0:e1]] = 0
+                spec[:, j1 - c0:, s0:s1] = 0
+            m = min(size, n_blocks * _BLOCK)
+            out[:, c0:c1] = _inverse_cropped(spec[..., :m], self.order[:m],
+                                             self.scatter[c0 // _CHUNK], self.grid, (oy, ox),
+                                             u, workers, _zero_pad_spectrum)
+
+
+def _small_int(top: int) -> type:
+    """The smallest signed integer type holding ``-top..top`` (numpy sorts 16-bit
+    integers by radix, stably and fast)."""
+    return np.int16 if top < 2**15 else np.int32 if top < 2**31 else np.int64
+
+
+def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.ndarray,
+                 q: np.ndarray, t0: np.ndarray, rate: np.ndarray, dz: float,
+                 grid: tuple[int, int], pitch: tuple[float, float], nz: int) -> np.ndarray:
+    """The last plane index each component takes part in (-1: none, at most nz - 1).
+
+    Band limit: the lateral shift ``|p| t(z)``, ``t(z) = t0 + (z - z0) rate``, must
+    stay within half the grid (as in the per-plane transfer). Decay: a component
+    whose weight ``|a| |step|^j`` has fallen below ``_TINY`` of the frequency's
+    largest is zero to rounding (evanescent waves, absorption).
+    """
+    My, Mx = grid
+    dx, dy = pitch
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        room = np.minimum(np.where(p[None, :] != 0, Mx * dx / 2 / np.abs(p[None, :]), np.inf),
+                          np.where(q[:, None] != 0, My * dy / 2 / np.abs(q[:, None]), np.inf))
+        j_band = np.floor((room - t0) / (rate * dz))
+        j_band = np.where(evanescent, np.inf, np.nan_to_num(j_band, nan=np.inf, neginf=-1))
+        mag = np.abs(a)
+        floor = _TINY * mag.max(initial=0.0)
+        decay = np.abs(step)
+        j_decay = np.where(decay < 1, np.floor(np.log(floor / mag) / np.log(decay)), np.inf)
+        j_decay = np.where(mag > floor, np.nan_to_num(j_decay, nan=np.inf), -1)
+    return np.clip(np.minimum(j_band, j_decay), -1, nz - 1).astype(np.int32)
+
+
+def _inverse_cropped(spec: np.ndarray, flat: np.ndarray, scatter: tuple, grid: tuple[int, int],
+                     crop: tuple[int, int], u: int, workers: int,
+                     zero_pad: Any) -> np.ndarray:
+    """Inverse 2-D FFT of sparse spectra (values ``spec[..., m]`` at flat indices
+    ``flat`` of a ``grid``), cropped to ``crop``: x first over the live rows only
+    (``scatter``: those rows, and where each value goes in a buffer of them)."""
+    My, Mx = grid
+    oy, ox = crop
+    lead = spec.shape[:-1]
+    if u > 1:
+        full = np.zeros((*lead, My * Mx), dtype=spec.dtype)
+        full[..., flat] = spec
+        planes = sfft.ifft2(zero_pad(full.reshape((*lead, My, Mx)), u), axes=(-2, -1),
+                            workers=workers, overwrite_x=True)
+        return planes[..., :oy, :ox] * (u * u)
+    used, pos = scatter
+    buf = np.zeros((*lead, used.size * Mx), dtype=spec.dtype)
+    for i in np.ndindex(lead):   # one index at a time: much faster than broadcast
+        buf[i][pos] = spec[i]
+    half = sfft.ifft(buf.reshape((*lead, used.size, Mx)), axis=-1, workers=workers,
+                     overwrite_x=True)[..., :ox]
+    cols = np.zeros((*lead, My, ox), dtype=spec.dtype)
+    cols[..., used, :] = half
+    return sfft.ifft(cols, axis=-2, workers=workers, overwrite_x=True)[..., :oy, :]

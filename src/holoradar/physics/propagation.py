@@ -52,19 +52,26 @@ def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[floa
     """FFT grid for an ``(ny, nx)`` field.
 
     ``pad=False``: no padding (periodic). A float: that factor. ``pad=True``: at
-    least twice each size, and at least ``lambda*z_max/dx^2`` samples: the
-    angular spectrum samples its transfer phase ``kz*z`` every
-    ``dp = 2*pi/(M*dx)``, and at the band edge ``p = pi/dx`` that phase turns by
-    ``z*p*dp/k`` per sample, which stays below pi only when
-    ``M >= lambda*z/dx^2`` (the critical distance ``z_c = M*dx^2/lambda`` of
-    Voelz & Roggemann 2009). Beyond it the transfer function aliases.
+    least twice each size, and at least ``lambda*z_max/(dx*dx_edge)`` samples,
+    ``dx_edge = max(dx, lambda/2)``: the angular spectrum samples its transfer
+    phase ``kz*z`` every ``dp = 2*pi/(M*dx)``, and at the highest travelling
+    component ``p_edge = pi/dx_edge`` (the grid's band edge ``pi/dx``, or ``k``
+    when the data are sampled finer than lambda/2: beyond it the components are
+    evanescent and have no phase to sample) that phase turns by
+    ``z*p_edge*dp/k`` per sample, which stays below pi only when
+    ``M >= lambda*z/(dx*dx_edge)`` (for ``dx = lambda/2`` the critical distance
+    ``z_c = M*dx^2/lambda`` of Voelz & Roggemann 2009). Beyond it the transfer
+    function aliases; the steeper components that still would are dropped by the
+    band limit. ``wavelength`` is the one the phase runs at (half the free-space
+    wavelength for a transceiver's round trip).
     """
     if pad is True:
         dims = []
         for n, d in zip(shape, pitch[::-1] if pitch else (None, None), strict=True):
             m = 2 * n
             if d is not None and wavelength is not None:
-                m = max(m, int(np.ceil(wavelength * z_max / d**2)))
+                edge = max(d, wavelength / 2)
+                m = max(m, int(np.ceil(wavelength * z_max / (d * edge))))
             dims.append(sfft.next_fast_len(m, real=False))
         return tuple(dims)
     factor = 1.0 if pad is False else float(pad)
