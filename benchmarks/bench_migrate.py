@@ -67,7 +67,35 @@ def main() -> dict:
         sfft.fft2(a, workers=-1)
         return sfft.ifft2(stack, axes=(-2, -1), workers=-1)
 
+    work = field.copy()
+    work_big = big.copy()
+    work_stack = stack.copy()
+
+    def pair_in_place() -> object:  # the tight floor: no allocation at all
+        sfft.fft2(work, workers=-1, overwrite_x=True)
+        return sfft.ifft2(work, workers=-1, overwrite_x=True)
+
+    def pair_pad_in_place() -> object:
+        sfft.fft2(work_big, workers=-1, overwrite_x=True)
+        return sfft.ifft2(work_big, workers=-1, overwrite_x=True)
+
+    def volume_in_place() -> object:  # one batched in-place inverse FFT of all planes
+        return sfft.ifft2(work_stack, axes=(-2, -1), workers=-1, overwrite_x=True)
+
+    t_tight, t_tight_pad, t_tight_vol = best_times(pair_in_place, pair_pad_in_place,
+                                                   volume_in_place, repeat=7)
+    # Cold: a new frequency each call (no cached transfer function).
+    freqs = iter(F0 * (1 + 1e-6 * np.arange(1, 1000)))
+
+    def cold() -> object:
+        return hr.migrate(hr.Hologram(field, x, x, next(freqs)), 0.4, pad=False)
+
+    def cold_volume() -> object:
+        return hr.migrate(hr.Hologram(field, x, x, next(freqs)), zs, pad=False)
+
     t_pair, t_plane = best_times(pair, lambda: hr.migrate(holo, 0.4, pad=False))
+    (t_cold,) = best_times(cold, repeat=7)
+    (t_cold_vol,) = best_times(cold_volume, repeat=3)
     t_pair_pad, t_plane_pad = best_times(pair_pad, lambda: hr.migrate(holo, 0.4, pad=True))
     t_ffts, t_volume = best_times(volume_ffts, lambda: hr.migrate(holo, zs, pad=False),
                                   repeat=7)
@@ -76,6 +104,12 @@ def main() -> dict:
         "fft_pair_padded_s": t_pair_pad, "plane_padded_s": t_plane_pad,
         "plane_padded_over_pair_padded": t_plane_pad / t_pair_pad,
         "volume_s": t_volume, "volume_ffts_s": t_ffts, "volume_over_ffts": t_volume / t_ffts,
+        "fft_pair_in_place_s": t_tight, "plane_over_in_place_pair": t_plane / t_tight,
+        "fft_pair_padded_in_place_s": t_tight_pad,
+        "plane_padded_over_in_place_pair": t_plane_pad / t_tight_pad,
+        "volume_ifft_in_place_s": t_tight_vol, "volume_over_in_place": t_volume / t_tight_vol,
+        "cold_plane_s": t_cold, "cold_plane_over_pair": t_cold / t_pair,
+        "cold_volume_s": t_cold_vol, "cold_volume_over_ffts": t_cold_vol / t_ffts,
     })
     plane, pair_t = t_plane, t_pair
 
@@ -121,6 +155,17 @@ def table(r: dict) -> str:
          f"{r['plane_padded_over_pair_padded']:.2f}x fft2+ifft2 at 1024^2"),
         (f"{PLANES}-plane volume", f("volume_s"), f("volume_ffts_s"),
          f"{r['volume_over_ffts']:.2f}x (1 fft2 + {PLANES} ifft2)"),
+        ("one plane, 512^2, vs in-place pair", f("plane_s"), f("fft_pair_in_place_s"),
+         f"{r['plane_over_in_place_pair']:.2f}x in-place fft2+ifft2"),
+        ("one plane padded, vs in-place pair", f("plane_padded_s"),
+         f("fft_pair_padded_in_place_s"),
+         f"{r['plane_padded_over_in_place_pair']:.2f}x in-place pair at 1024^2"),
+        (f"{PLANES}-plane volume, vs in-place", f("volume_s"), f("volume_ifft_in_place_s"),
+         f"{r['volume_over_in_place']:.2f}x one batched in-place ifft2"),
+        ("cold plane (new frequency)", f("cold_plane_s"), f("fft_pair_s"),
+         f"{r['cold_plane_over_pair']:.2f}x fft2+ifft2"),
+        (f"cold {PLANES}-plane volume", f("cold_volume_s"), f("volume_ffts_s"),
+         f"{r['cold_volume_over_ffts']:.2f}x its FFTs"),
     ]
     for peer, key in (("LightPipes Forvard", "lightpipes"), ("diffractsim propagate",
                                                                 "diffractsim")):

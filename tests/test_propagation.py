@@ -104,3 +104,38 @@ def test_complex64_path_keeps_precision(rng):
     b = op128.adjoint(f)
     assert a.dtype == np.complex64
     assert np.linalg.norm(a - b) / np.linalg.norm(b) < 1e-5
+
+
+@pytest.mark.parametrize("monostatic", [False, True])
+@pytest.mark.parametrize("z", [0.12, 0.25, 0.31, 0.47])
+def test_cached_transfer_equals_the_layered_recursion(z, monostatic):
+    """Planes below the last interface reuse the transfer to its top times one
+    exponential, on one quadrant of the spectrum: it must equal the full layered
+    recursion evaluated on the whole grid (the band limit included), exactly
+    but for rounding: 1e-12."""
+    from holoradar.physics.propagation import (
+        _make_angular_transfer,
+        lateral_travel,
+        spectral_axes,
+        two_way_transfer,
+    )
+
+    medium = hr.Medium((0.1, 0.16, 0.3), (1, 4 + 0.3j, 9 + 0.5j, 6 + 0.2j))
+    shape, dx, dy, k = (48, 64), 0.004, 0.005, 207.0
+    U = _make_angular_transfer(shape, dx, dy, k, z, medium, True, np.dtype(complex), False,
+                               None, monostatic)
+    p, q = spectral_axes(shape, dx, dy)
+    kappa2 = q[:, None] ** 2 + p[None, :] ** 2
+    if monostatic:
+        ref = two_way_transfer(k, medium, kappa2, z)
+        t = 0.5 * lateral_travel(k, medium, kappa2 / 4, z)
+        evanescent = kappa2 > 4 * k * k
+    else:
+        ref = medium.vertical_transfer(k, kappa2, z, 0.0)
+        t = lateral_travel(k, medium, kappa2, z)
+        evanescent = kappa2 > k * k
+    with np.errstate(invalid="ignore"):
+        ok = (np.abs(p)[None, :] * t <= 64 * dx / 2) & (np.abs(q)[:, None] * t <= 48 * dy / 2)
+    ref = np.where(ok | evanescent, ref, 0)
+    assert np.count_nonzero(ref) > 0.2 * ref.size
+    np.testing.assert_allclose(U, ref, rtol=0, atol=1e-12 * np.abs(ref).max())

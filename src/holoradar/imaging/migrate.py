@@ -25,7 +25,13 @@ from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
 from ..physics.incident import incident_on_planes
 from ..physics.medium import Medium
-from ..physics.propagation import DEFAULT_SNR_DB, AngularSpectrum, Fresnel, padded_shape
+from ..physics.propagation import (
+    DEFAULT_SNR_DB,
+    AngularSpectrum,
+    Fresnel,
+    ifft2_cropped,
+    padded_shape,
+)
 from . import kspace
 
 __all__ = ["IlluminationWarning", "migrate"]
@@ -230,7 +236,10 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         _multiply_planes(H, Ucs, prod)
         if u > 1:
             prod = _zero_pad_spectrum(prod, u)
-        planes = sfft.ifft2(prod, axes=(-2, -1), workers=op.workers, overwrite_x=True)
+        if fov == "full" or in_place:
+            planes = sfft.ifft2(prod, axes=(-2, -1), workers=op.workers, overwrite_x=True)
+        else:
+            planes = ifft2_cropped(prod, (oy, ox), op.workers, overwrite=True)
         if fov == "full":
             planes = np.roll(planes, (sy, sx), axis=(-2, -1))
         if not (in_place and np.may_share_memory(planes, out)):

@@ -255,6 +255,11 @@ class Medium:
         n = complex(np.sqrt(complex(self.eps[region])))
         return -n if n.imag < 0 else n
 
+    @property
+    def is_lossless(self) -> bool:
+        """True when no region absorbs (every permittivity real)."""
+        return all(complex(e).imag == 0 for e in self.eps)
+
     def region_of(self, z: float | np.ndarray) -> np.ndarray | int:
         """Index of the region that contains range ``z`` (interfaces belong below).
 
