@@ -322,16 +322,18 @@ class _Basis:
         kappa2 = q[:, None] ** 2 + p[None, :] ** 2
         last = medium.n_regions - 1
         top = medium.top_of(last)
-        if monostatic:
+        if last == 0:                       # free space: nothing above the planes
+            kz = 2 * medium.kz(k, kappa2 / 4, 0) if monostatic else medium.kz(k, kappa2, 0)
+            base, t_top = np.ones(kappa2.shape, complex), np.zeros(kappa2.shape)
+        elif monostatic:
             base = two_way_transfer(k, medium, kappa2, top)
             kz = 2 * medium.kz(k, kappa2 / 4, last)
             t_top = 0.5 * lateral_travel(k, medium, kappa2 / 4, top)
-            evanescent = kappa2 > 4 * k * k
         else:
             base = medium.vertical_transfer(k, kappa2, top, 0.0)
             kz = medium.kz(k, kappa2, last)
             t_top = lateral_travel(k, medium, kappa2, top)
-            evanescent = kappa2 > k * k
+        evanescent = kappa2 > (4 * k * k if monostatic else k * k)
         # Lateral travel per metre in the deepest region, 1/Re(kz) (the round trip:
         # (1/2)/Re(kz_j(kappa/2)) = 1/Re(2 kz_j(kappa/2)), the same form).
         rate = np.where(kz.real > 0, 1 / np.where(kz.real > 0, kz.real, 1), np.inf)
@@ -354,7 +356,9 @@ def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: floa
     b = _basis(shape, dx, dy, k, medium, monostatic)
     deepest = medium.region_of(z) == medium.n_regions - 1
     if deepest:
-        U = b.base * np.exp(1j * b.kz * (z - b.top))
+        U = np.exp(1j * (z - b.top) * b.kz)
+        if b.top > 0:
+            U *= b.base
     elif monostatic:
         U = two_way_transfer(k, medium, b.kappa2, z)
     else:
