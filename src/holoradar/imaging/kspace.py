@@ -91,11 +91,7 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
     plan = _CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
     data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
     batch = data.shape[:-3]
-    # Pruned forward FFT: along x over the recorded rows only, then along y.
-    H = sfft.fft(data.astype(work, copy=False), n=Mx, axis=-1, workers=workers)
-    H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
-    Hc = plan.gather(H.reshape((-1, plan.nf, My * Mx)), weights)
-    del H
+    Hc = plan.gather(data.reshape((-1, *data.shape[-3:])), weights, work, workers)
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((*batch, zs.size, oy, ox), dtype=work)
@@ -219,15 +215,26 @@ class _Plan:
             arr.setflags(write=False)
         return plan
 
-    def gather(self, H: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        """The live components of spectra ``H`` (``(B, nf, My*Mx)``), weighted and
-        taken to the first plane, block by block: ``(nb, B, nf, _BLOCK)``."""
+    def gather(self, data: np.ndarray, weights: np.ndarray, work: np.dtype,
+               workers: int) -> np.ndarray:
+        """The live spectral components of ``data`` (``(B, nf, ny, nx)``), weighted
+        and taken to the first plane, block by block: ``(nb, B, nf, _BLOCK)``.
+
+        One frequency at a time (the padded spectra of all of them are never held
+        at once): a pruned forward FFT, along x over the recorded rows only, then
+        along y.
+        """
+        My, Mx = self.grid
+        B = data.shape[0]
         nb = self.gain.shape[0]
         idx = np.zeros(nb * _BLOCK, dtype=np.intp)
         idx[:self.order.size] = self.order
-        Hc = H[:, :, idx].reshape((H.shape[0], self.nf, nb, _BLOCK)).transpose(2, 0, 1, 3)
-        Hc = np.ascontiguousarray(Hc)
-        Hc *= self.gain[:, None] * weights[None, None, :, None].astype(Hc.dtype)
+        Hc = np.empty((nb, B, self.nf, _BLOCK), dtype=work)
+        for i in range(self.nf):
+            H = sfft.fft(data[:, i].astype(work, copy=False), n=Mx, axis=-1, workers=workers)
+            H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
+            H = H.reshape((B, My * Mx))[:, idx].reshape((B, nb, _BLOCK)).transpose(1, 0, 2)
+            np.multiply(H, self.gain[:, None, i] * work.type(weights[i]), out=Hc[:, :, i])
         return Hc
 
     def sum_planes(self, Hc: np.ndarray, out: np.ndarray, u: int, workers: int) -> None:
@@ -237,8 +244,6 @@ class _Plan:
         data and steps contiguous and in cache. ``Hc`` (from :meth:`gather`) is
         consumed.
         """
-        from .migrate import _zero_pad_spectrum
-
         B = Hc.shape[1]
         nz, oy, ox = out.shape[-3:]
         size = self.order.size
@@ -261,7 +266,7 @@ class _Plan:
             m = min(size, n_blocks * _BLOCK)
             out[:, c0:c1] = _inverse_cropped(spec[..., :m], self.order[:m],
                                              self.scatter[c0 // _CHUNK], self.grid, (oy, ox),
-                                             u, workers, _zero_pad_spectrum)
+                                             u, workers)
 
 
 def _small_int(top: int) -> type:
@@ -296,26 +301,40 @@ def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.
 
 
 def _inverse_cropped(spec: np.ndarray, flat: np.ndarray, scatter: tuple, grid: tuple[int, int],
-                     crop: tuple[int, int], u: int, workers: int,
-                     zero_pad: Any) -> np.ndarray:
+                     crop: tuple[int, int], u: int, workers: int) -> np.ndarray:
     """Inverse 2-D FFT of sparse spectra (values ``spec[..., m]`` at flat indices
-    ``flat`` of a ``grid``), cropped to ``crop``: x first over the live rows only
-    (``scatter``: those rows, and where each value goes in a buffer of them)."""
+    ``flat`` of a ``grid``), interpolated ``u`` times (zero padding of the
+    spectrum) and cropped to ``crop``: along x over the live rows only
+    (``scatter``: those rows, and where each value goes in a buffer of them),
+    crop, then along y."""
     My, Mx = grid
     oy, ox = crop
     lead = spec.shape[:-1]
-    if u > 1:
-        full = np.zeros((*lead, My * Mx), dtype=spec.dtype)
-        full[..., flat] = spec
-        planes = sfft.ifft2(zero_pad(full.reshape((*lead, My, Mx)), u), axes=(-2, -1),
-                            workers=workers, overwrite_x=True)
-        return planes[..., :oy, :ox] * (u * u)
     used, pos = scatter
     buf = np.zeros((*lead, used.size * Mx), dtype=spec.dtype)
     for i in np.ndindex(lead):   # one index at a time: much faster than broadcast
         buf[i][pos] = spec[i]
-    half = sfft.ifft(buf.reshape((*lead, used.size, Mx)), axis=-1, workers=workers,
-                     overwrite_x=True)[..., :ox]
+    buf = _pad_axis(buf.reshape((*lead, used.size, Mx)), u, -1)
+    half = sfft.ifft(buf, axis=-1, workers=workers, overwrite_x=True)[..., :ox]
     cols = np.zeros((*lead, My, ox), dtype=spec.dtype)
     cols[..., used, :] = half
-    return sfft.ifft(cols, axis=-2, workers=workers, overwrite_x=True)[..., :oy, :]
+    planes = sfft.ifft(_pad_axis(cols, u, -2), axis=-2, workers=workers,
+                       overwrite_x=True)[..., :oy, :]
+    return planes * (u * u) if u > 1 else planes
+
+
+def _pad_axis(S: np.ndarray, u: int, axis: int) -> np.ndarray:
+    """Embed an FFT-ordered spectrum along one axis in a ``u`` times longer one
+    (exact band-limited interpolation; an even size's Nyquist bin split in half
+    between + and -, so that a real signal stays real)."""
+    if u == 1:
+        return S
+    S = np.moveaxis(S, axis, -1)
+    M = S.shape[-1]
+    out = np.zeros((*S.shape[:-1], u * M), dtype=S.dtype)
+    h = (M + 1) // 2
+    out[..., :h] = S[..., :h]
+    out[..., u * M - M // 2:] = S[..., M - M // 2:]
+    if M % 2 == 0:
+        out[..., M // 2] = out[..., u * M - M // 2] = 0.5 * out[..., u * M - M // 2]
+    return np.moveaxis(out, -1, axis)
