@@ -225,14 +225,21 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     # Without crop or interpolation the products are computed in the output array itself
     # and transformed in place: one multiply and one inverse FFT per plane, no copies.
     in_place = u == 1 and (My, Mx) == (ny, nx) and fov == "aperture"
-    out = np.empty((*batch, zs.size, oy, ox), dtype=work)
-    show = out.size > 2e8 if progress is None else progress
+    out = (None if in_place and zs.size == 1
+           else np.empty((*batch, zs.size, oy, ox), dtype=work))
+    show = zs.size * oy * ox * max(1, int(np.prod(batch))) > 2e8 if progress is None \
+        else progress
     bar = tqdm(total=zs.size, desc="migrate", unit="plane") if show else None
     chunk = zs.size if in_place else _CHUNK
     for c0 in range(0, zs.size, chunk):
         Ucs = op.adjoint_transfers[c0:c0 + chunk]
-        prod = out[..., c0:c0 + len(Ucs), :, :] if in_place else np.empty(
-            (*batch, len(Ucs), My, Mx), dtype=work)
+        if in_place and zs.size == 1:
+            # One plane: multiply into the spectrum itself (ours, no longer needed),
+            # transform it in place and keep it as the image: no allocation.
+            prod = out = H[..., None, :, :]
+        else:
+            prod = out[..., c0:c0 + len(Ucs), :, :] if in_place else np.empty(
+                (*batch, len(Ucs), My, Mx), dtype=work)
         _multiply_planes(H, Ucs, prod)
         if u > 1:
             prod = _zero_pad_spectrum(prod, u)
