@@ -17,6 +17,7 @@ Examples
 from . import theory
 from ._validate import AliasingWarning
 from .data.hologram import C0, Hologram, Image
+from .data.pose import Pose
 from .data.wideband import apply_calibration, conjugate, remove_mean
 from .imaging.iq import iq_convention
 from .imaging.migrate import IlluminationWarning, migrate
@@ -53,6 +54,7 @@ __all__ = [
     "PlaneWave",
     "PointSource",
     "PointTarget",
+    "Pose",
     "Scene",
     "StreamImager",
     "SuppressionReport",

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_axis, as_finite_complex, check_frequency, uniform_step
+from .pose import IDENTITY, Pose
 
 __all__ = ["C0", "Hologram", "Image"]
 
@@ -46,6 +47,11 @@ class Hologram:
         by a transceiver at (x, y), so the wave travels there and back (round-trip
         wavenumber 2k); it has no separate ``source``. False (default): a
         receiver array lit by a separate source.
+    pose : Pose, optional
+        Where the aperture stands in the world (the medium's frame): its centre
+        and tilt. ``x`` and ``y`` stay the element coordinates in the aperture's
+        own plane; :attr:`points` gives their world positions. Default: the
+        identity (the aperture on the plane z = 0, facing down).
 
     Examples
     --------
@@ -65,9 +71,11 @@ class Hologram:
     frequency: float | np.ndarray
     source: Any = None
     monostatic: bool = False
+    pose: Pose = IDENTITY
 
     def __init__(self, data: Any, x: Any, y: Any, frequency: Any, *,
-                 source: Any = None, monostatic: bool = False) -> None:
+                 source: Any = None, monostatic: bool = False,
+                 pose: Pose | None = None) -> None:
         arr = as_finite_complex(data, "data", min_ndim=2)
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
@@ -81,6 +89,8 @@ class Hologram:
             raise ValueError("a monostatic hologram (scanned transceiver) has no separate "
                              "source: the transceiver at each sample lights the scene itself; "
                              "pass source=None")
+        if pose is not None and not isinstance(pose, Pose):
+            raise ValueError(f"pose must be a holoradar.Pose or None, got {type(pose).__name__}")
         arr = arr.copy()  # the hologram owns its data: the caller's array is never shared
         arr.setflags(write=False)
         xa.setflags(write=False)
@@ -91,6 +101,7 @@ class Hologram:
         object.__setattr__(self, "frequency", f)
         object.__setattr__(self, "source", source)
         object.__setattr__(self, "monostatic", bool(monostatic))
+        object.__setattr__(self, "pose", IDENTITY if pose is None else pose)
 
     @property
     def is_wideband(self) -> bool:
@@ -146,7 +157,7 @@ class Hologram:
         if not -self.nf <= i < self.nf:
             raise ValueError(f"index must be in [0, {self.nf}), got {index}")
         return Hologram(self.data[..., i, :, :], self.x, self.y, float(self.frequencies[i]),
-                        source=self.source, monostatic=self.monostatic)
+                        source=self.source, monostatic=self.monostatic, pose=self.pose)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -166,9 +177,9 @@ class Hologram:
 
     @property
     def points(self) -> np.ndarray:
-        """Element positions (N, 3) on the plane z = 0, row-major over (y, x) like ``data``."""
-        X, Y = np.meshgrid(self.x, self.y)
-        return np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+        """World positions (N, 3) of the elements, metres, row-major over (y, x) like
+        ``data`` (on the plane z = 0 for the identity pose)."""
+        return self.pose.grid_points(self.x, self.y).reshape(-1, 3)
 
     def with_data(self, data: Any) -> Hologram:
         """A copy with new ``data`` of the same trailing shape (coordinates kept).
@@ -180,15 +191,15 @@ class Hologram:
         (2, 4, 4)
         """
         return Hologram(data, self.x, self.y, self.frequency, source=self.source,
-                        monostatic=self.monostatic)
+                        monostatic=self.monostatic, pose=self.pose)
 
     def replace(self, **changes: Any) -> Hologram:
         """A copy with some fields replaced (``dataclasses.replace`` semantics)."""
         kw = {"data": self.data, "x": self.x, "y": self.y, "frequency": self.frequency,
-              "source": self.source, "monostatic": self.monostatic}
+              "source": self.source, "monostatic": self.monostatic, "pose": self.pose}
         kw.update(changes)
-        src, mono = kw.pop("source"), kw.pop("monostatic")
-        return Hologram(**kw, source=src, monostatic=mono)
+        src, mono, pose = kw.pop("source"), kw.pop("monostatic"), kw.pop("pose")
+        return Hologram(**kw, source=src, monostatic=mono, pose=pose)
 
 
 def _frequency_axis(frequency: Any, shape: tuple[int, ...]) -> float | np.ndarray:

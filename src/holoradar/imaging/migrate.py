@@ -32,7 +32,7 @@ from ..physics.propagation import (
     ifft2_cropped,
     padded_shape,
 )
-from . import kspace
+from . import kspace, oblique
 
 __all__ = ["IlluminationWarning", "migrate"]
 
@@ -47,7 +47,9 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
             dtype: type | None = None, progress: bool | None = None,
             combine: Literal["coherent", "incoherent", "none"] = "coherent",
             equalize: bool | Sequence[float] | np.ndarray = True,
-            algorithm: Literal["auto", "kspace", "frequency"] = "auto") -> Image:
+            algorithm: Literal["auto", "kspace", "frequency"] = "auto",
+            frame: Literal["aperture", "ground"] = "aperture", x: Any = None,
+            y: Any = None) -> Image:
     """Back-propagate a hologram to the planes at range ``z``.
 
     Parameters
@@ -132,6 +134,19 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         transceiver or a normal plane wave, and no loss to compensate
         (:mod:`holoradar.imaging.kspace`). ``"auto"`` (default) takes ``"kspace"``
         where it applies.
+    frame : {"aperture", "ground"}
+        ``"aperture"`` (default): planes parallel to the aperture at distances
+        ``z`` from it, pixels in its own coordinates (a tilted aperture: its own
+        depth sweep, in free space; a level one at a height ``pose.center[2]``:
+        through the medium seen from there). ``"ground"``: horizontal planes at
+        world ranges ``z`` (the medium's frame), through the layers with
+        refraction, pixels in world coordinates over the aperture's footprint
+        (or ``x``, ``y``): for a tilted aperture (``hologram.pose``). Method: an
+        exact rotation of the angular spectrum onto a horizontal reference plane
+        (:mod:`holoradar.imaging.oblique`), then the same migration.
+    x, y : array_like, optional
+        ``frame="ground"``: uniform world grids of the image, metres (default:
+        the footprint of the elements at their pitch / ``upsample``).
     Returns
     -------
     Image
@@ -164,13 +179,33 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
     if algorithm not in ("auto", "kspace", "frequency"):
         raise ValueError(f"algorithm must be 'auto', 'kspace' or 'frequency', got {algorithm!r}")
+    if frame not in ("aperture", "ground"):
+        raise ValueError(f"frame must be 'aperture' or 'ground', got {frame!r}")
+    if frame == "aperture" and (x is not None or y is not None):
+        raise ValueError("x and y set the world grid of frame='ground'; frame='aperture' "
+                         "images on the aperture's own grid (use upsample)")
+    if medium is not None and not isinstance(medium, Medium):
+        raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
+    pose = hologram.pose
+    if frame == "aperture" and medium is not None and not medium.is_free_space \
+            and not pose.is_level:
+        raise ValueError("a tilted aperture (hologram.pose.tilt > 0) sees the layers "
+                         "obliquely: image through a medium with frame='ground'")
     if hologram.is_wideband:
         return _migrate_wideband(hologram, z, medium=medium, method=method, pad=pad,
                                  upsample=upsample, compensate_loss=compensate_loss,
                                  snr_db=snr_db, fov=fov, dtype=dtype, progress=progress,
-                                 combine=combine, equalize=equalize, algorithm=algorithm)
+                                 combine=combine, equalize=equalize, algorithm=algorithm,
+                                 frame=frame, x=x, y=y)
     zs = check_nonnegative_ranges(z, "z")
     scalar = np.ndim(z) == 0
+    if frame == "ground":
+        return _migrate_ground(hologram, zs, scalar, medium, method=method, pad=pad,
+                               upsample=upsample, compensate_loss=compensate_loss,
+                               snr_db=snr_db, dtype=dtype, x=x, y=y)
+    if medium is not None and pose.center[2] != 0.0 and not medium.is_free_space:
+        # A level aperture at a height: the layers as seen from its plane.
+        medium = oblique._shifted(medium, pose.center[2])
     if method not in ("angular", "fresnel"):
         raise ValueError(f"method must be 'angular' or 'fresnel', got {method!r}")
     if fov not in ("aperture", "full"):
@@ -262,6 +297,29 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     return Image(data, x, y, zs, hologram.frequency, method, has_z_axis=not scalar)
 
 
+def _migrate_ground(hologram: Hologram, zs: np.ndarray, scalar: bool, medium: Medium | None, *,
+                    method: str, pad: Any, upsample: Any, compensate_loss: bool,
+                    snr_db: Any, dtype: Any, x: Any, y: Any) -> Image:
+    """``frame="ground"``: horizontal world planes through the layers."""
+    if method != "angular":
+        raise ValueError("frame='ground' uses the exact angular spectrum: method must be "
+                         f"'angular', got {method!r}")
+    if isinstance(upsample, bool) or not float(upsample).is_integer() or int(upsample) < 1:
+        raise ValueError(f"upsample must be a whole number >= 1, got {upsample!r}")
+    dx, dy = hologram.pitch
+    warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram",
+                    round_trip=hologram.monostatic)
+    med = medium if medium is not None else Medium.free_space()
+    gain = None
+    if compensate_loss and not med.is_lossless:
+        gain = (as_real(snr_db, "snr_db") if snr_db is not None else DEFAULT_SNR_DB)
+    img = oblique.migrate_ground(hologram, zs, med, x=x, y=y, pad=pad,
+                                 upsample=int(upsample), compensate_loss=gain, dtype=dtype)
+    data = img.data[..., 0, :, :] if scalar else img.data
+    return Image(data, img.x, img.y, zs, hologram.frequency, img.method,
+                 has_z_axis=not scalar)
+
+
 class IlluminationWarning(UserWarning):
     """Frequencies were combined with an assumed incident field."""
 
@@ -302,9 +360,10 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
                       "source for the true one", IlluminationWarning, stacklevel=3)
     warn_if_aliased(max(hologram.pitch), C0 / hologram.frequencies[-1], "hologram",
                     round_trip=hologram.monostatic)
-    fast = kspace.applicable(hologram, zs_all, med, method=kw.get("method", "angular"),
-                             fov=kw.get("fov", "aperture"), combine=combine,
-                             compensate_loss=kw.get("compensate_loss", True))
+    fast = kw.get("frame") != "ground" and hologram.pose.is_identity and kspace.applicable(
+        hologram, zs_all, med, method=kw.get("method", "angular"),
+        fov=kw.get("fov", "aperture"), combine=combine,
+        compensate_loss=kw.get("compensate_loss", True))
     if algorithm == "kspace" and not fast:
         raise ValueError("algorithm='kspace' needs uniformly spaced planes in the deepest "
                          "region, fov='aperture', combine='coherent', a transceiver or a "

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_axis
+from ..data.pose import IDENTITY, Pose
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave
 from .targets import PlanarTarget, PointTarget
@@ -18,7 +19,7 @@ __all__ = ["Aperture", "Scene"]
 
 @dataclass(frozen=True, eq=False)
 class Aperture:
-    """A receiver array on the plane z = 0: a grid, or elements anywhere on the plane.
+    """A receiver array: a grid, or elements anywhere on its plane, placed by a pose.
 
     Parameters
     ----------
@@ -32,6 +33,9 @@ class Aperture:
     monostatic : bool
         The elements are positions of a scanned transceiver (each sends and
         receives) rather than receivers lit by a separate source.
+    pose : Pose
+        Where the aperture's plane stands in the world (default: the plane z = 0,
+        facing down); ``x``, ``y`` and ``elements`` are coordinates in that plane.
 
     Examples
     --------
@@ -45,8 +49,13 @@ class Aperture:
     y: np.ndarray
     elements: np.ndarray | None = None
     monostatic: bool = False
+    pose: Pose = IDENTITY
 
     def __post_init__(self) -> None:
+        if self.pose is None:
+            object.__setattr__(self, "pose", IDENTITY)
+        if not isinstance(self.pose, Pose):
+            raise ValueError(f"pose must be a holoradar.Pose, got {type(self.pose).__name__}")
         object.__setattr__(self, "x", as_axis(self.x, "x"))
         object.__setattr__(self, "y", as_axis(self.y, "y"))
         if self.elements is not None:
@@ -60,13 +69,14 @@ class Aperture:
             object.__setattr__(self, "elements", el)
 
     @classmethod
-    def from_positions(cls, positions: np.ndarray, *, monostatic: bool = False) -> Aperture:
-        """Elements at arbitrary positions (N, 2) on the plane z = 0, metres."""
+    def from_positions(cls, positions: np.ndarray, *, monostatic: bool = False,
+                       pose: Pose | None = None) -> Aperture:
+        """Elements at arbitrary positions (N, 2) in the aperture's plane, metres."""
         el = np.asarray(positions, dtype=float)
         if el.ndim != 2 or el.shape[1] != 2:
             raise ValueError(f"positions must have shape (N, 2), got {el.shape}")
         xs, ys = np.unique(el[:, 0]), np.unique(el[:, 1])
-        return cls(xs, ys, el, monostatic)
+        return cls(xs, ys, el, monostatic, pose or IDENTITY)
 
     @property
     def is_grid(self) -> bool:
@@ -75,10 +85,13 @@ class Aperture:
 
     @classmethod
     def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
-             center: tuple[float, float] = (0.0, 0.0), monostatic: bool = False) -> Aperture:
+             center: tuple[float, float] = (0.0, 0.0), monostatic: bool = False,
+             pose: Pose | None = None) -> Aperture:
         """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``.
 
-        ``monostatic=True`` makes it the scan grid of one transceiver.
+        ``monostatic=True`` makes it the scan grid of one transceiver; ``pose``
+        places and tilts its plane (``center`` is then in the aperture's own
+        coordinates; the pose's centre is the world position of their origin).
         """
         for name, v in (("n", n), ("ny", ny)):
             if v is not None and (not float(v).is_integer() or int(v) < 1):
@@ -89,7 +102,7 @@ class Aperture:
         py = pitch if pitch_y is None else pitch_y
         x = (np.arange(int(n)) - (int(n) - 1) / 2) * pitch + center[0]
         y = (np.arange(ny) - (ny - 1) / 2) * py + center[1]
-        return cls(x, y, monostatic=monostatic)
+        return cls(x, y, monostatic=monostatic, pose=pose or IDENTITY)
 
     @classmethod
     def paper(cls) -> Aperture:
@@ -105,11 +118,11 @@ class Aperture:
 
     @property
     def points(self) -> np.ndarray:
-        """Element positions (N, 3), z = 0; row-major over (y, x) for a grid."""
+        """World positions (N, 3) of the elements, metres (on z = 0 for the identity
+        pose); row-major over (y, x) for a grid."""
         if self.elements is not None:
-            return np.c_[self.elements, np.zeros(len(self.elements))]
-        X, Y = np.meshgrid(self.x, self.y)
-        return np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+            return self.pose.to_world(self.elements[:, 0], self.elements[:, 1])
+        return self.pose.grid_points(self.x, self.y).reshape(-1, 3)
 
 
 @dataclass(frozen=True)

@@ -111,7 +111,9 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
             else bool(monostatic))
     medium, source = scene.medium, scene.source
     if not medium.is_free_space and np.any(pts[:, 2] >= medium.z_interfaces[0]):
-        raise ValueError("aperture elements must lie above the ground surface")
+        raise ValueError(f"aperture: its elements must lie above the ground surface (z < "
+                         f"{medium.z_interfaces[0]} m); the deepest is at z = "
+                         f"{pts[:, 2].max():.4g} m (check the pose's centre and tilt)")
     if mono and include_direct:
         raise ValueError("include_direct has no meaning for a monostatic aperture (a "
                          "transceiver's coupling to itself is not modelled)")
@@ -139,7 +141,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         shape = (*data.shape[:-1], aperture.y.size, aperture.x.size)
         return Hologram(data.reshape(shape), aperture.x, aperture.y,
                         freqs if wide else float(freqs[0]),
-                        source=None if mono else source, monostatic=mono)
+                        source=None if mono else source, monostatic=mono, pose=aperture.pose)
     return data
 
 
