@@ -229,3 +229,31 @@ def test_smuthi_tilted_array_sphere():
         errors[name] = np.hypot(img.x[ix] - bright[0], img.y[iy] - bright[1])
     assert errors["sand"] <= lam_m / 2
     assert errors["none"] > 2 * lam_m
+
+
+@pytest.mark.parametrize("azimuth_deg", [0.0, 90.0, 30.0])
+def test_spectrum_on_the_reference_plane_is_the_direct_sum(azimuth_deg):
+    """The factored non-uniform Fourier sum (by grid rows, by grid columns, or in
+    full, depending on the pose) equals the direct sum over the elements,
+    H(k) = sum_e d_e exp(-i [p (x_e - x0) + q (y_e - y0) + conj(kz) (z_ref - z_e)]),
+    to rounding (1e-12 of the largest value)."""
+    from holoradar.imaging.oblique import _spectrum_on_plane
+
+    rng = np.random.default_rng(1)
+    x = (np.arange(10) - 4.5) * 0.015
+    y = (np.arange(8) - 3.5) * 0.015
+    d = rng.standard_normal((8, 10)) + 1j * rng.standard_normal((8, 10))
+    pose = hr.Pose((0.01, -0.02, 0.05), tilt=np.radians(35), azimuth=np.radians(azimuth_deg))
+    h = hr.Hologram(d, x, y, F0, pose=pose)
+    origin = (-0.1, -0.1, 0.2)
+    H = _spectrum_on_plane(h, (40, 44), (0.01, 0.012), origin, np.dtype(complex), gap=0.2)
+    P, Q = np.meshgrid(2 * np.pi * np.fft.fftfreq(44, 0.01), 2 * np.pi * np.fft.fftfreq(40, 0.012))
+    kz = np.sqrt((K0**2 - P**2 - Q**2).astype(complex))
+    kz = np.where(kz.imag < 0, -kz, kz)
+    ref = np.zeros_like(H)
+    for de, (px, py, pz) in zip(d.ravel(), h.points, strict=True):
+        ref += de * np.exp(-1j * (P * (px - origin[0]) + Q * (py - origin[1])
+                                  + np.conj(kz) * (origin[2] - pz)))
+    kept = H != 0
+    assert np.all(kept[P**2 + Q**2 <= K0**2])
+    np.testing.assert_allclose(H[kept], ref[kept], rtol=0, atol=1e-12 * np.abs(ref).max())

@@ -101,6 +101,7 @@ class Pose:
         rz = np.array([[cp, -sp, 0.0], [sp, cp, 0.0], [0.0, 0.0, 1.0]])
         ry = np.array([[ct, 0.0, st], [0.0, 1.0, 0.0], [-st, 0.0, ct]])
         r = rz @ ry @ rz.T
+        r[np.abs(r) < 1e-15] = 0.0  # cos(pi/2) = 6e-17: keep axes along world axes exact
         if self.tilt == 0.0:
             r = np.eye(3)   # exactly: the level layout must reproduce the plain one bit for bit
         return r

@@ -43,13 +43,13 @@ from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import (
     _CACHE,
-    _angular_transfer,
     _basis,
-    ifft2_cropped,
+    _make_angular_transfer,
     lateral_travel,
     padded_shape,
     spectral_axes,
 )
+from .kspace import _pad_axis
 
 _EVANESCENT_FLOOR = 1e-8
 
@@ -114,13 +114,25 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
     dxw, dyw = uniform_step(xo, "x"), uniform_step(yo, "y")
     work = np.dtype(dtype if dtype is not None else (
         np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
+    kk = 2 * k if mono else k
+    # The shortest air path below the reference plane to anything imaged: components
+    # evanescent in the air that it damps below 1e-8 cannot matter; the rest of the
+    # spectrum lies within kappa_max, so the FFT grid needs a pitch of pi/kappa_max
+    # at most: a finer output grid is reached by exact (zero-padded spectrum)
+    # interpolation, u times along each axis.
+    gap = float(min(zs.min(), medium.z_interfaces[0] if not medium.is_free_space
+                    else np.inf) - z_ref)
+    kappa_max = np.hypot(kk, -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12))
+    ux = max(1, int(np.floor(np.pi / (kappa_max * dxw) + 1e-9)))
+    uy = max(1, int(np.floor(np.pi / (kappa_max * dyw) + 1e-9)))
+    dcx, dcy = ux * dxw, uy * dyw
     # The world grid starts at the first output pixel and spans the output and the
     # elements (the grid is periodic: elements before the origin wrap, harmlessly,
     # as long as nothing overlaps), padded for the lateral travel down to z.
-    span_x = max(xo[-1], pts[:, 0].max()) - min(xo[0], pts[:, 0].min()) + dxw
-    span_y = max(yo[-1], pts[:, 1].max()) - min(yo[0], pts[:, 1].min()) + dyw
-    n0 = (int(np.ceil(span_y / dyw - 1e-9)), int(np.ceil(span_x / dxw - 1e-9)))
-    lam = (np.pi if mono else 2 * np.pi) / k
+    span_x = max(xo[-1], pts[:, 0].max()) - min(xo[0], pts[:, 0].min()) + dcx
+    span_y = max(yo[-1], pts[:, 1].max()) - min(yo[0], pts[:, 1].min()) + dcy
+    n0 = (int(np.ceil(span_y / dcy - 1e-9)), int(np.ceil(span_x / dcx - 1e-9)))
+    lam = 2 * np.pi / kk
     rise = float(z_ref - pts[:, 2].min())       # height span of the elements
     # The farthest any element lies from any pixel, along x and y: a component that
     # shifts laterally by t maps an element onto the pixel t away, and, the grid
@@ -128,41 +140,55 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
     # while t <= M dx - reach (and every true pair needs t <= reach).
     reach = (max(xo[-1] - pts[:, 0].min(), pts[:, 0].max() - xo[0]),
              max(yo[-1] - pts[:, 1].min(), pts[:, 1].max() - yo[0]))
-    grid = padded_shape(n0, pad, pitch=(dxw, dyw), wavelength=lam,
+    grid = padded_shape(n0, pad, pitch=(dcx, dcy), wavelength=lam,
                         z_max=float(zs.max() - z_ref + rise))
     if pad is True:
         # Room for the smooth band limit between reach and M d - reach: M d >= 4 reach
         # (the kernel then matches the exact layered Green's function to ~1%, tested).
         grid = tuple(max(m, sfft.next_fast_len(int(np.ceil(4 * r / d)), real=False))
-                     for m, r, d in zip(grid, reach[::-1], (dyw, dxw), strict=True))
+                     for m, r, d in zip(grid, reach[::-1], (dcy, dcx), strict=True))
     shifted = _shifted(medium, z_ref)
-    # The shortest air path below the reference plane to anything imaged: components
-    # evanescent in the air that it damps below the floor cannot matter.
-    gap = float(min(zs.min(), medium.z_interfaces[0] if not medium.is_free_space
-                    else np.inf) - z_ref)
-    H = _spectrum_on_plane(hologram, grid, (dxw, dyw), (xo[0], yo[0], z_ref), work, gap)
+    H = _spectrum_on_plane(hologram, grid, (dcx, dcy), (xo[0], yo[0], z_ref), work, gap)
     out = np.empty((*H.shape[:-2], zs.size, yo.size, xo.size), dtype=work)
-    workers = -1 if grid[0] * grid[1] >= 128 * 128 else 1
+    workers = -1 if grid[0] * grid[1] * ux * uy >= 128 * 128 else 1
     for j, z in enumerate(zs):
-        Uc = _angular_transfer(grid, dxw, dyw, k, float(z - z_ref), shifted, False, work, True,
-                               compensate_loss, mono)
-        # The band limit over the whole path: from the plane up to the reference
-        # plane, and on through the air up to the highest element.
-        Uc = Uc * _band_limit(grid, (dxw, dyw), k, shifted, float(z - z_ref), rise, mono,
-                              reach)
-        out[..., j, :, :] = ifft2_cropped(H * Uc, (yo.size, xo.size), workers, overwrite=True)
+        Uc = _ground_transfer(grid, (dcx, dcy), k, shifted, float(z - z_ref), rise, mono,
+                              reach, work, compensate_loss)
+        out[..., j, :, :] = _inverse_upsampled(H * Uc, (uy, ux), (yo.size, xo.size), workers)
     return Image(out, xo.copy(), yo.copy(), zs, hologram.frequency, "angular:ground")
 
 
-def _band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float, medium: Medium,
-                z: float, rise: float, mono: bool, reach: tuple[float, float]) -> np.ndarray:
-    """1 where a component's lateral shift from range ``z`` up to ``rise`` above the
-    reference plane stays below ``M d - reach`` along each axis (its periodic alias
-    then misses every pixel), 0 elsewhere; evanescent components are kept (they
-    decay)."""
-    key = ("ground-band", grid, pitch, k, medium, z, rise, mono, reach)
-    return _CACHE.get(key, lambda: _make_band_limit(grid, pitch, k, medium, z, rise, mono,
-                                                    reach))
+def _inverse_upsampled(S: np.ndarray, u: tuple[int, int], crop: tuple[int, int],
+                       workers: int) -> np.ndarray:
+    """``ifft2`` of spectra ``S`` interpolated ``u = (uy, ux)`` times (zero padding of
+    the spectrum), cropped to ``crop``: along x, crop, then along y."""
+    uy, ux = u
+    oy, ox = crop
+    half = sfft.ifft(_pad_axis(S, ux, -1), axis=-1, workers=workers,
+                     overwrite_x=True)[..., :ox]
+    out = sfft.ifft(_pad_axis(half, uy, -2), axis=-2, workers=workers,
+                    overwrite_x=True)[..., :oy, :]
+    return out * (ux * uy) if ux * uy > 1 else out
+
+
+def _ground_transfer(grid: tuple[int, int], pitch: tuple[float, float], k: float,
+                     medium: Medium, z: float, rise: float, mono: bool,
+                     reach: tuple[float, float], work: np.dtype,
+                     compensate_loss: float | None) -> np.ndarray:
+    """The adjoint transfer from range ``z`` to the reference plane times the band
+    limit of the whole path (cached as one array)."""
+    key = ("ground-transfer", grid, pitch, k, medium, z, rise, mono, reach, work.str,
+           compensate_loss)
+
+    def make() -> np.ndarray:
+        U = _make_angular_transfer(grid, *pitch, k, z, medium, False, work, True,
+                                   compensate_loss, mono)
+        out = U * _make_band_limit(grid, pitch, k, medium, z, rise, mono, reach)
+        out = out.astype(work, copy=False)
+        out.setflags(write=False)
+        return out
+
+    return _CACHE.get(key, make)
 
 
 def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float,
@@ -234,20 +260,40 @@ def _spectrum_on_plane(hologram: Hologram, grid: tuple[int, int], pitch: tuple[f
     d = hologram.data.astype(work, copy=False)
     lead = d.shape[:-2]
     d = d.reshape((-1, *d.shape[-2:]))                          # (B, ny, nx)
+    if basis.mode == "columns":
+        # x' horizontal along x: its phase depends on the grid column only. One small
+        # product per column, then per column a (My x ny) matrix-vector product.
+        t = np.matmul(d, basis.ea.T)                             # (B, ny, Mx)
+        t = np.moveaxis(t, 2, 1)[..., None]                      # (B, Mx, ny, 1)
+        Hd = np.matmul(basis.eb, t)[..., 0]                      # (B, Mx, My)
+        return (np.swapaxes(Hd, 1, 2) * basis.phase).reshape((*lead, My, Mx))
+    if basis.mode == "rows":
+        # y' horizontal along y: the same with the roles of the axes exchanged.
+        t = np.matmul(basis.eb, d)[..., None]                    # (B, My, nx, 1)
+        Hd = np.matmul(basis.ea, t)[..., 0]                      # (B, My, Mx)
+        return (Hd * basis.phase).reshape((*lead, My, Mx))
     # sum_j d[b, i, j] Ea[m, j] -> (B, n, ny), then sum_i Eb[m, i] * that.
     t = np.einsum("bij,mj->bmi", d, basis.ea, optimize=True)
-    vals = np.einsum("bmi,mi->bm", t, basis.eb, optimize=True) * basis.phase
+    vals = np.einsum("bmi,mi->bm", t, basis.eb, optimize=True)
+    vals = vals * basis.phase
     H = np.zeros((d.shape[0], My * Mx), dtype=work)
     H[:, basis.index] = vals
     return H.reshape((*lead, My, Mx))
+
+
+def _dense(values: np.ndarray, index: np.ndarray, grid: tuple[int, int]) -> np.ndarray:
+    """Values at flat indices of a grid, zero elsewhere, shape ``grid``."""
+    out = np.zeros(grid[0] * grid[1], dtype=values.dtype)
+    out[index] = values
+    return out.reshape(grid)
 
 
 class _Remap:
     """Cached factors of the non-uniform Fourier sum for one geometry."""
 
     def __init__(self, index: np.ndarray, ea: np.ndarray, eb: np.ndarray,
-                 phase: np.ndarray) -> None:
-        self.index, self.ea, self.eb, self.phase = index, ea, eb, phase
+                 phase: np.ndarray, mode: str) -> None:
+        self.index, self.ea, self.eb, self.phase, self.mode = index, ea, eb, phase, mode
         self.nbytes = index.nbytes + ea.nbytes + eb.nbytes + phase.nbytes
 
     @classmethod
@@ -266,9 +312,30 @@ class _Remap:
         K = np.stack([P.ravel()[index], Q.ravel()[index], -np.conj(kz[index])], axis=1)
         u, v = pose.u, pose.v
         c = np.asarray(pose.center) - np.asarray(origin)
-        ea = np.exp(-1j * np.outer(K @ u, xl)).astype(work)
-        eb = np.exp(-1j * np.outer(K @ v, yl)).astype(work)
-        phase = np.exp(-1j * (K @ c)).astype(work)
+        # An aperture axis along a world axis (azimuth 0 or 90 degrees, or level):
+        # its phase depends on one grid index, and the sum over it is a small
+        # product per grid row or column (the common layouts, several times faster).
+        My, Mx = grid
+        phase = np.exp(-1j * (K @ c))
+        if u[1] == 0 and u[2] == 0:
+            mode = "columns"
+            ea = np.exp(-1j * np.outer(p * u[0], xl))                 # (Mx, nx)
+            eb = np.zeros((Mx * My, yl.size), complex)               # (Mx, My, ny)
+            eb[(index % Mx) * My + index // Mx] = np.exp(-1j * np.outer(K @ v, yl))
+            eb = eb.reshape(Mx, My, yl.size)
+            phase = _dense(phase, index, grid)
+        elif v[0] == 0 and v[2] == 0:
+            mode = "rows"
+            ea = np.zeros((My * Mx, xl.size), complex)               # (My, Mx, nx)
+            ea[index] = np.exp(-1j * np.outer(K @ u, xl))
+            ea = ea.reshape(My, Mx, xl.size)
+            eb = np.exp(-1j * np.outer(q * v[1], yl))                 # (My, ny)
+            phase = _dense(phase, index, grid)
+        else:
+            mode = "full"
+            ea = np.exp(-1j * np.outer(K @ u, xl))
+            eb = np.exp(-1j * np.outer(K @ v, yl))
+        ea, eb, phase = ea.astype(work), eb.astype(work), phase.astype(work)
         for a in (index, ea, eb, phase):
             a.setflags(write=False)
-        return cls(index, ea, eb, phase)
+        return cls(index, ea, eb, phase, mode)
