@@ -71,3 +71,19 @@ def test_theory_command():
                                     "--frequency", str(hr.C0 / 0.03)])
     assert res.exit_code == 0
     assert abs(json.loads(res.output)["lateral_resolution_m"] - 0.045) < 1e-12
+
+
+def test_plan_oblique_command(tmp_path):
+    """The planner from the command line: JSON numbers, a layout figure, and no
+    overwrite without --force; a horn in the ground is refused and writes nothing."""
+    out = tmp_path / "plan.png"
+    res = CliRunner().invoke(main, ["plan-oblique", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert d["miss_distance_m"] > 0 and 0 <= d["glare_fraction"] < 0.01
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    again = CliRunner().invoke(main, ["plan-oblique", "--out", str(out)])
+    assert again.exit_code != 0 and "--force" in again.output
+    bad = tmp_path / "bad.png"
+    res = CliRunner().invoke(main, ["plan-oblique", "--horn", "0,0,0.35", "--out", str(bad)])
+    assert res.exit_code == 2 and "source" in res.output and not bad.exists()

@@ -16,6 +16,7 @@ Examples
 
 from . import theory
 from ._validate import AliasingWarning
+from .analysis.oblique_plan import ObliquePlan, plan_oblique
 from .data.hologram import C0, Hologram, Image
 from .data.pose import Pose
 from .data.wideband import apply_calibration, conjugate, remove_mean
@@ -50,6 +51,7 @@ __all__ = [
     "IlluminationWarning",
     "Image",
     "Medium",
+    "ObliquePlan",
     "PlanarTarget",
     "PlaneWave",
     "PointSource",
@@ -66,6 +68,7 @@ __all__ = [
     "iq_convention",
     "migrate",
     "permittivity",
+    "plan_oblique",
     "remove_mean",
     "simulate",
     "suppress_surface",

@@ -105,6 +105,82 @@ def image(hologram_file: Path, z: str, eps: str | None, z_surface: float | None,
     click.echo(json.dumps({"peak_m": pk, "out": str(out)}))
 
 
+def _triple(text: str, name: str) -> tuple[float, float, float]:
+    try:
+        v = tuple(float(t) for t in text.split(","))
+    except ValueError:
+        v = ()
+    if len(v) != 3:
+        raise click.BadParameter(f"expected x,y,z in metres, got {text!r}", param_hint=name)
+    return v  # type: ignore[return-value]
+
+
+@main.command(name="plan-oblique")
+@click.option("--n", default=16, show_default=True, type=click.IntRange(2, 1024),
+              help="Elements per side.")
+@click.option("--pitch", default=0.025, show_default=True, type=float, help="Element pitch, m.")
+@click.option("--center", default="0,-0.15,0.05", show_default=True,
+              help="Array centre x,y,z (world, m; z the range below the reference plane).")
+@click.option("--tilt", default=35.0, show_default=True, type=float, help="Degrees.")
+@click.option("--azimuth", default=90.0, show_default=True, type=float, help="Degrees.")
+@click.option("--horn", default="0,-0.08,0.25", show_default=True, help="Horn x,y,z (m).")
+@click.option("--pattern", default=20.0, show_default=True, type=float,
+              help="Horn pattern exponent m of cos^m.")
+@click.option("--eps", default="2.5+0.0125j", show_default=True, help="Ground permittivity.")
+@click.option("--z-surface", default=0.30, show_default=True, type=float,
+              help="Ground surface range (m).")
+@click.option("--target", default="0,0.05,0.42", show_default=True,
+              help="Target x,y,z (m); the horn aims at it.")
+@click.option("--frequency", default=9.9e9, show_default=True, type=float, help="Hz")
+@click.option("--out", default=None, type=click.Path(dir_okay=False, path_type=Path),
+              help="PNG of the layout with its rays (not overwritten unless --force).")
+@click.option("--force", is_flag=True, help="Overwrite --out if it exists.")
+def plan_oblique_cmd(n: int, pitch: float, center: str, tilt: float, azimuth: float, horn: str,
+                     pattern: float, eps: str, z_surface: float, target: str, frequency: float,
+                     out: Path | None, force: bool) -> None:
+    """Plan an oblique layout: where the horn's reflection falls, the glare fraction,
+    the effective distance and resolution at the target (JSON; a figure with --out)."""
+    from ..analysis.oblique_plan import plan_oblique
+    from ..data.pose import Pose
+    from ..model.scene import Aperture
+    from ..physics.medium import Medium
+    from ..physics.sources import PointSource
+    from . import plotting
+    from .atomic import write_atomic
+
+    c, hp, tg = _triple(center, "--center"), _triple(horn, "--horn"), _triple(target, "--target")
+    if out is not None and out.exists() and not force:
+        raise click.BadParameter(f"{out} exists; pass --force to overwrite it",
+                                 param_hint="--out")
+    try:
+        pose = Pose(c, tilt=np.radians(tilt), azimuth=np.radians(azimuth))
+        ap = Aperture.grid(n, pitch, pose=pose)
+        medium = Medium.half_space(z_surface, complex(eps))
+        src = PointSource(hp, pattern_exponent=pattern,
+                          axis=tuple(np.subtract(tg, hp)))
+        plan = plan_oblique(ap, src, medium, tg, frequency=frequency)
+    except ValueError as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    if out is not None:
+        fig = plotting.plot_oblique_plan(plan, ap, src, medium, tg)
+        write_atomic(out, plotting.to_png(fig))
+    click.echo(json.dumps({
+        "specular_point_m": plan.specular_point.tolist(),
+        "miss_distance_m": plan.miss_distance,
+        "glare_fraction": plan.glare_fraction,
+        "effective_distance_m": plan.effective_distance,
+        "lateral_resolution_m": list(plan.lateral_resolution),
+        "tilts_missing_deg": [float(np.degrees(plan.tilts_missing.min())),
+                              float(np.degrees(plan.tilts_missing.max()))]
+        if plan.tilts_missing.size else [],
+        "horn_heights_missing_m": [float(plan.heights_missing.min()),
+                                   float(plan.heights_missing.max())]
+        if plan.heights_missing.size else [],
+        **({"out": str(out)} if out is not None else {}),
+    }, indent=2))
+
+
 @main.command(name="theory")
 @click.option("--frequency", default=9.9e9, show_default=True, type=float, help="Hz")
 @click.option("--aperture", default=0.40, show_default=True, type=float, help="full width, m")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -179,4 +180,54 @@ def plot_spectrum(p: np.ndarray, q: np.ndarray, spectrum: np.ndarray,
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title)
     fig.colorbar(m, ax=ax, label="|F(p, q)| (dB re max)")
+    return fig
+
+
+def plot_oblique_plan(plan: Any, aperture: Any, source: Any, medium: Any,
+                      target: Any) -> Figure:
+    """Side view of an oblique layout with its rays (paper Fig. 17): the array, the
+    horn's boresight to the specular point and its reflection, and the refracted
+    ray from the array's centre to the target.
+
+    The view is the vertical plane through the array's centre along its azimuth
+    (horizontal axis: distance along that direction, metres; vertical: range z).
+    """
+    pose = aperture.pose
+    c = np.asarray(pose.center)
+    along = np.array([np.cos(pose.azimuth), np.sin(pose.azimuth), 0.0])
+
+    def h(p: np.ndarray) -> float:
+        return float((np.asarray(p) - c) @ along)
+
+    fig = Figure(figsize=(8, 4.6), layout="constrained")
+    ax = fig.subplots()
+    zs = medium.z_interfaces[0]
+    pts = aperture.points
+    horn = np.asarray(getattr(source, "position", getattr(source, "center", c)), float)
+    tgt = np.asarray(target, float)
+    xs = [h(p) for p in pts] + [h(horn), h(tgt)]
+    lo, hi = min(xs) - 0.15, max(xs) + 0.15
+    ax.axhspan(zs, max(tgt[2], zs) + 0.15, color="tan", alpha=0.5,
+               label=f"ground, eps {medium.eps[1]}")
+    ax.plot([h(p) for p in pts], pts[:, 2], ".", ms=2, color="C0", label="array elements")
+    ax.plot(h(horn), horn[2], "s", color="C1", ms=8, label="horn")
+    ax.plot(h(tgt), tgt[2], "kx", ms=9, label="target")
+    if np.all(np.isfinite(plan.specular_point)):
+        sp = plan.specular_point
+        ax.plot([h(horn), h(sp)], [horn[2], sp[2]], "-", color="C1", lw=1.5,
+                label="boresight")
+        far = sp + 0.8 * plan.reflected_direction
+        ax.plot([h(sp), h(far)], [sp[2], far[2]], "--", color="C3", lw=1.5,
+                label=f"specular reflection (misses by {plan.miss_distance * 100:.0f} cm)"
+                if plan.miss_distance > 0 else "specular reflection (hits the array)")
+    rp = plan.refraction_point
+    ax.plot([h(c), h(rp), h(tgt)], [c[2], rp[2], tgt[2]], "-", color="C2", lw=1,
+            label=f"refracted ray, effective distance {plan.effective_distance:.2f} m")
+    ax.set(xlim=(lo, hi), ylim=(max(tgt[2], zs) + 0.15, min(pts[:, 2].min(), horn[2]) - 0.1),
+           xlabel="distance along the array's azimuth (m)", ylabel="range z below the "
+           "reference plane (m)",
+           title=f"oblique layout: tilt {np.degrees(pose.tilt):.0f} deg, glare fraction "
+                 f"{plan.glare_fraction:.2%}")
+    ax.set_aspect("equal")
+    ax.legend(loc="lower left", fontsize=7)
     return fig
