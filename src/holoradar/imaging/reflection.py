@@ -246,6 +246,15 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     >>> rep.glare_suppression_db > 20
     True
     """
+    if isinstance(hologram, Hologram) and not hologram.pose.is_identity \
+            and method != "background":
+        # The glare models (mirror image, Gaussian fit in its plane) assume the
+        # aperture on z = 0 facing the ground. A tilted array avoids the glare by
+        # geometry: plan_oblique says how much of it still reaches the elements.
+        raise ValueError("hologram.pose: suppress_surface models an aperture on z = 0 "
+                         "facing the ground; for a posed (tilted or raised) aperture use "
+                         "method='background' (a measured empty scene), or keep the glare "
+                         "out by the layout (holoradar.plan_oblique)")
     src = source if source is not None else getattr(hologram, "source", None)
     if src is None and method != "background":
         raise ValueError("source must be given (the radiator as a PointSource), or carried "

@@ -63,6 +63,9 @@ def _check_views(holograms: Sequence[Hologram]) -> list[Hologram]:
                 np.allclose(h.x, h0.x) and np.allclose(h.y, h0.y)):
             raise ValueError(f"holograms[{i}] is sampled on another aperture grid than "
                              "holograms[0]: views must share one aperture")
+        if h.pose != h0.pose:
+            raise ValueError(f"holograms[{i}] has pose {h.pose} but holograms[0] {h0.pose}: "
+                             "views must share one aperture (move the source, not the array)")
         if h.data.shape != h0.data.shape:
             raise ValueError(f"holograms[{i}] has data shape {h.data.shape}, holograms[0] "
                              f"{h0.data.shape}")
@@ -124,7 +127,9 @@ def align_phases(images: np.ndarray, *, passes: int = 3) -> tuple[np.ndarray, np
 def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
                medium: Medium | None = None, mode: Mode = "coherent", upsample: int = 1,
                fov: Literal["aperture", "full"] = "aperture",
-               return_views: bool = False) -> Image | tuple[Image, np.ndarray]:
+               return_views: bool = False, frame: Literal["aperture", "ground"] = "aperture",
+               x: np.ndarray | None = None,
+               y: np.ndarray | None = None) -> Image | tuple[Image, np.ndarray]:
     """Image several views of one scene and sum them (synthetic aperture).
 
     Parameters
@@ -144,6 +149,11 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     return_views : bool
         Also return the per-view images with their incident phase removed,
         shape (K, nz, ny, nx) (or (K, ny, nx) for a scalar z).
+    frame, x, y
+        As in :func:`holoradar.migrate`: ``frame="ground"`` images the views of a
+        tilted aperture (all with one ``pose``) on horizontal world planes through
+        the layers, where each view's incident field is removed (the oblique
+        layout with the horn moved along the ground).
 
     Returns
     -------
@@ -166,15 +176,23 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
         raise ValueError(f"mode must be 'coherent', 'amplitude' or 'quasi-coherent', got "
                          f"{mode!r}")
     med = medium if medium is not None else Medium.free_space()
+    # A tilted aperture's views are imaged on horizontal world planes ("ground"),
+    # where the sources' incident fields are known.
+    where = {"frame": frame, "x": x, "y": y} if frame != "aperture" or x is not None \
+        or y is not None else {}
+    if not views[0].pose.is_identity and frame == "aperture" and not views[0].pose.is_level:
+        raise ValueError("views from a tilted aperture are summed on ground planes: pass "
+                         "frame='ground' (the incident fields are known in the world frame)")
     if views[0].is_wideband:
         # Each view's frequencies are summed coherently after their own incident phases
         # (migrate does that with the view's source); the views then add as below.
-        imgs = [migrate(v, z, medium=medium, upsample=upsample, fov=fov) for v in views]
+        imgs = [migrate(v, z, medium=medium, upsample=upsample, fov=fov, **where)
+                for v in views]
         img = imgs[0]
         aligned = np.stack([im.data if im.has_z_axis else im.data[None] for im in imgs])
         return _combine(aligned, img, mode, return_views)
     stack = views[0].with_data(np.stack([v.data for v in views]))
-    img = migrate(stack, z, medium=medium, upsample=upsample, fov=fov)
+    img = migrate(stack, z, medium=medium, upsample=upsample, fov=fov, **where)
     g = img.data if img.has_z_axis else img.data[:, None]
     k = views[0].k
     aligned = np.empty_like(g)
