@@ -7,7 +7,7 @@ import numpy as np
 from ..data.hologram import Image
 from ..model.targets import PlanarTarget
 
-__all__ = ["main_lobe_width", "peak_position", "shape_correlation"]
+__all__ = ["circle_fit", "main_lobe_width", "peak_position", "shape_correlation"]
 
 
 def _parabolic(a: np.ndarray, i: int, *, log: bool = False) -> float:
@@ -111,3 +111,31 @@ def shape_correlation(image: Image, target: PlanarTarget) -> float:
     fx = np.clip(ix, 0, target.x.size - 1)
     mask[inside] = (np.abs(target.reflectivity) > 0)[np.ix_(fy, fx)][inside]
     return float(np.corrcoef(a.ravel(), mask.ravel())[0, 1])
+
+
+def circle_fit(image: np.ndarray, x: np.ndarray, y: np.ndarray,
+               level: float = 0.5) -> tuple[float, float, float]:
+    """Diameter and centre ``(d, cx, cy)`` in metres of the circle through the
+    bright pixels of a 2-D image (``|image| >= level * max``), by weighted
+    algebraic least squares, ``x^2 + y^2 = 2 a x + 2 b y + c`` (weights
+    ``sqrt|image|``): the outline of a disk imaged by its rim.
+
+    Examples
+    --------
+    >>> x = y = np.linspace(-0.2, 0.2, 81)
+    >>> X, Y = np.meshgrid(x, y)
+    >>> ring = np.exp(-((np.hypot(X - 0.02, Y) - 0.09) / 0.01) ** 2)
+    >>> [round(v, 2) for v in circle_fit(ring, x, y)]
+    [0.18, 0.02, 0.0]
+    """
+    a = np.abs(np.asarray(image))
+    if a.ndim != 2 or a.shape != (len(y), len(x)):
+        raise ValueError(f"image must be 2-D of shape (len(y), len(x)) = ({len(y)}, "
+                         f"{len(x)}), got {a.shape}")
+    m = a >= level * a.max()
+    Y, X = np.meshgrid(np.asarray(y, float), np.asarray(x, float), indexing="ij")
+    w = np.sqrt(a[m])
+    A = np.c_[2 * X[m], 2 * Y[m], np.ones(int(m.sum()))] * w[:, None]
+    b = (X[m] ** 2 + Y[m] ** 2) * w
+    (cx, cy, c), *_ = np.linalg.lstsq(A, b, rcond=None)
+    return float(2 * np.sqrt(max(c + cx**2 + cy**2, 0.0))), float(cx), float(cy)
