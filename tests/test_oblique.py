@@ -439,3 +439,21 @@ def test_effective_distance_is_where_a_free_space_sweep_focuses(target):
     expected = along + theory.focal_shift(lam, plan.effective_distance, ap.size[0])
     assert abs(zs[iz] - expected) <= theory.longitudinal_resolution(
         lam, plan.effective_distance, ap.size[0]) / 4
+
+
+def test_level_aperture_at_a_height_in_its_own_frame():
+    """A level array 8 cm below the reference plane, 7 frequencies: in its own frame
+    the planes are distances from it, the layers are seen from its height, and the
+    frequencies are phased by the incident field at the pixels' world positions.
+    The point 0.42 m deep (0.34 m from the array) focuses there, as in the ground
+    frame (2 mm planes: to the plane)."""
+    sand = hr.Medium.half_space(0.3, 2.5)
+    target = (0.02, -0.01, 0.42)
+    pose = hr.Pose((0.0, 0.0, 0.08))
+    h = hr.simulate(hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget(target)]),
+                    hr.Aperture.grid(24, 0.012, pose=pose), np.linspace(8e9, 12e9, 7),
+                    include_surface=False)
+    own = hr.migrate(h, np.arange(0.30, 0.38, 0.002), medium=sand)
+    ground = hr.migrate(h, np.arange(0.38, 0.46, 0.002), medium=sand, frame="ground")
+    assert own.peak()[2] + 0.08 == pytest.approx(target[2], abs=1e-9)
+    assert ground.peak()[2] == pytest.approx(target[2], abs=1e-9)

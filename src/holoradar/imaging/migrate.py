@@ -205,6 +205,9 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
                                snr_db=snr_db, dtype=dtype, x=x, y=y)
     if medium is not None and pose.center[2] != 0.0 and not medium.is_free_space:
         # A level aperture at a height: the layers as seen from its plane.
+        if pose.center[2] >= medium.z_interfaces[0]:
+            raise ValueError(f"hologram.pose puts the aperture at z = {pose.center[2]:.4g} m, "
+                             f"at or below the ground surface ({medium.z_interfaces[0]} m)")
         medium = oblique._shifted(medium, pose.center[2])
     if method not in ("angular", "fresnel"):
         raise ValueError(f"method must be 'angular' or 'fresnel', got {method!r}")
@@ -384,7 +387,9 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
             img = migrate(hologram.at_frequency(i), z, medium=medium, **kw)
         data = img.data if img.has_z_axis else img.data[..., None, :, :]
         if not hologram.monostatic and combine != "incoherent":
-            data = data * _incident_phasor(hologram.source, kf, med, img)
+            data = data * _incident_phasor(hologram.source, kf, med, img,
+                                           None if kw.get("frame") == "ground"
+                                           else hologram.pose)
         data = w[i] * data
         if combine == "none":
             parts.append(data)
@@ -403,9 +408,24 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
                  f"{img.method}:{combine}", has_z_axis=img.has_z_axis)
 
 
-def _incident_phasor(source: Any, k: float, medium: Medium, img: Image) -> np.ndarray:
+def _incident_phasor(source: Any, k: float, medium: Medium, img: Image,
+                     pose: Any = None) -> np.ndarray:
     """``conj(E0)/|E0|`` on every image plane (nz, ny, nx); E0 = the transfer at normal
-    incidence without a source."""
+    incidence without a source. ``pose``: the image is in that aperture's own frame
+    (planes parallel to it at distances z); the incident field is taken at the
+    pixels' world positions."""
+    if pose is not None and not pose.is_identity:
+        X, Y = np.meshgrid(img.x, img.y)
+        pts = (pose.to_world(X, Y)[None] + img.z[:, None, None, None] * pose.normal)
+        if source is None:
+            # A plane wave at normal incidence: its transfer to each pixel's range.
+            zu, inv = np.unique(np.round(pts[..., 2], 12), return_inverse=True)
+            e0 = np.array([complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(z)))
+                           for z in zu])[inv].reshape(pts.shape[:-1])
+        else:
+            e0 = source.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
+        mag = np.abs(e0)
+        return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
     if source is None:
         e0 = np.array([complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zj)))
                        for zj in img.z])[:, None, None] * np.ones((1, img.y.size, img.x.size))
