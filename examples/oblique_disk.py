@@ -32,24 +32,31 @@ DEPTH = 0.41
 
 
 def scene_views(y0s: np.ndarray, sides: tuple[float, ...] = (-0.25, 0.25),
-                pixel: float = 0.003) -> tuple[list[hr.Hologram], hr.Medium]:
-    """The views of the disk, one per horn position (x = side, y = y0)."""
-    sand = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
-    disk = hr.PlanarTarget.from_shape("disk", DEPTH, diameter=DIAMETER, reflection=-1.0,
+                pixel: float = 0.003, *, medium: hr.Medium | None = None,
+                depth: float = DEPTH, tilt_deg: float = 35.0, snr_db: float | None = None,
+                include_surface: bool = False,
+                pattern: float = 4.0) -> tuple[list[hr.Hologram], hr.Medium]:
+    """The views of the disk, one per horn position (x = side, y = y0), the horn
+    5 cm above the surface (default: sand at 0.30 m)."""
+    ground = medium if medium is not None else hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+    surface = ground.z_interfaces[0]
+    disk = hr.PlanarTarget.from_shape("disk", depth, diameter=DIAMETER, reflection=-1.0,
                                       pixel=pixel)
-    normal = np.array([0.0, np.sin(np.radians(35)), np.cos(np.radians(35))])
-    pose = hr.Pose(tuple(np.array([0, 0, DEPTH]) - 0.35 * normal), tilt=np.radians(35),
+    t = np.radians(tilt_deg)
+    normal = np.array([0.0, np.sin(t), np.cos(t)])
+    pose = hr.Pose(tuple(np.array([0, 0, depth]) - 0.35 * normal), tilt=t,
                    azimuth=np.radians(90))
     ap = hr.Aperture.grid(16, 0.025, pose=pose)
     views = []
-    for y0 in y0s:
-        for side in sides:
-            pos = np.array([side, y0, 0.25])
-            horn = hr.PointSource(tuple(pos), pattern_exponent=4,
-                                  axis=tuple(np.array([0.0, 0.0, DEPTH]) - pos))
-            views.append(hr.simulate(hr.Scene(sand, horn, [disk]), ap, 9.9e9,
-                                     include_surface=False))
-    return views, sand
+    for i, y0 in enumerate(y0s):
+        for j, side in enumerate(sides):
+            pos = np.array([side, y0, surface - 0.05])
+            horn = hr.PointSource(tuple(pos), pattern_exponent=pattern,
+                                  axis=tuple(np.array([0.0, 0.0, depth]) - pos))
+            views.append(hr.simulate(hr.Scene(ground, horn, [disk]), ap, 9.9e9,
+                                     include_surface=include_surface, snr_db=snr_db,
+                                     seed=i * len(sides) + j))
+    return views, ground
 
 
 def main(out: Path) -> dict:
