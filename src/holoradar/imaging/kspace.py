@@ -36,6 +36,7 @@ from ..physics.propagation import (
     _CACHE,
     lateral_travel,
     padded_shape,
+    spectral_quadrant,
     two_way_transfer,
 )
 from ..physics.sources import PlaneWave
@@ -139,15 +140,10 @@ class _Plan:
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
               z0: float, dz: float, nz: int, medium: Medium, mono: bool,
               phase_incident: bool, work: np.dtype, used: np.ndarray) -> _Plan:
-        My, Mx = grid
+        Mx = grid[1]
         # Everything depends on |p| and |q| only: compute on one quadrant of the
         # spectrum and unfold (four times less work for a cold start).
-        ix, iy = np.arange(Mx), np.arange(My)
-        ix, iy = np.minimum(ix, Mx - ix), np.minimum(iy, My - iy)
-        p = 2 * np.pi * np.arange(ix.max() + 1) / (Mx * dx)
-        q = 2 * np.pi * np.arange(iy.max() + 1) / (My * dy)
-        unfold = (iy[:, None] * p.size + ix[None, :]).ravel()
-        kappa2 = q[:, None] ** 2 + p[None, :] ** 2
+        p, q, kappa2, unfold = spectral_quadrant(grid, dx, dy)
         last = medium.n_regions - 1
         n_last = medium.n(last)
         nf = len(ks)

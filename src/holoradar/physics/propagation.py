@@ -106,6 +106,25 @@ def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndar
     return (2 * np.pi * sfft.fftfreq(nx, dx), 2 * np.pi * sfft.fftfreq(ny, dy))
 
 
+def spectral_quadrant(shape: tuple[int, int], dx: float, dy: float
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One quadrant of an FFT grid's wavenumbers and the map back to the grid.
+
+    Returns ``(p, q, kappa2, unfold)``: ``|p|`` and ``|q|`` (rad/m, from 0 to the
+    grid's band edge), ``kappa2 = q^2 + p^2`` of shape (len(q), len(p)), and the
+    flat quadrant index of every grid component (``values.ravel()[unfold]``
+    reshaped to ``shape`` unfolds a quadrant array). Whatever depends on ``|p|``
+    and ``|q|`` only costs a quarter on the quadrant.
+    """
+    My, Mx = shape
+    ix, iy = np.arange(Mx), np.arange(My)
+    ix, iy = np.minimum(ix, Mx - ix), np.minimum(iy, My - iy)
+    p = 2 * np.pi * np.arange(ix.max() + 1) / (Mx * dx)
+    q = 2 * np.pi * np.arange(iy.max() + 1) / (My * dy)
+    unfold = (iy[:, None] * p.size + ix[None, :]).ravel()
+    return p, q, q[:, None] ** 2 + p[None, :] ** 2, unfold
+
+
 _FREE = Medium.free_space()
 
 
@@ -313,13 +332,7 @@ class _Basis:
     @classmethod
     def build(cls, shape: tuple[int, int], dx: float, dy: float, k: float, medium: Medium,
               monostatic: bool) -> _Basis:
-        My, Mx = shape
-        ix, iy = np.arange(Mx), np.arange(My)
-        ix, iy = np.minimum(ix, Mx - ix), np.minimum(iy, My - iy)
-        p = 2 * np.pi * np.arange(ix.max() + 1) / (Mx * dx)
-        q = 2 * np.pi * np.arange(iy.max() + 1) / (My * dy)
-        unfold = (iy[:, None] * p.size + ix[None, :]).ravel()
-        kappa2 = q[:, None] ** 2 + p[None, :] ** 2
+        p, q, kappa2, unfold = spectral_quadrant(shape, dx, dy)
         last = medium.n_regions - 1
         top = medium.top_of(last)
         if last == 0:                       # free space: nothing above the planes
