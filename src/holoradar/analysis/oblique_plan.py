@@ -15,10 +15,12 @@ whole hemisphere. (``simulate`` gives the same power from the exact reflected
 field: tested.)
 
 Target: the ray from the aperture's centre to the target refracts at the
-surface (Fermat: least optical path ``L_air + Re(n) L_ground``). Its apparent
-distance in free space is ``L_air + L_ground/Re(n)`` for the fan of rays across
-the plane of incidence (sagittal) and ``L_air + L_ground cos^2(theta_i) /
-(Re(n) cos^2(theta_t))`` within it (tangential); the effective distance is
+surface and at every interface above the target (Snell, ``Re(n)`` of each
+layer: the path of least optical length). With ``L_m`` its length and
+``theta_m`` its angle from vertical in region ``m`` (the air ``m = 0``), its
+apparent distance in free space is ``sum L_m/Re(n_m)`` for the fan of rays
+across the plane of incidence (sagittal) and ``sum L_m cos^2(theta_0) /
+(Re(n_m) cos^2(theta_m))`` within it (tangential); the effective distance is
 their mean, where a free-space depth sweep parallel to the aperture focuses
 best. Lateral resolution there: ``lambda L_eff / A`` (``A`` the aperture's
 width seen across the ray).
@@ -29,7 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import brentq
 
 from ..data.hologram import C0
 from ..physics.medium import Medium
@@ -227,21 +229,8 @@ def plan_oblique(aperture: object, source: object, medium: Medium, target: objec
         miss = _miss(aperture, spec, refl)
     fraction = _glare_fraction(k, medium, source, horn, axis, aperture)
     # The refracted ray to the target (Fermat) and its apparent distances.
-    n = medium.n(medium.region_of(tgt[2])).real
-
-    def path(xy: np.ndarray) -> float:
-        s = np.array([xy[0], xy[1], zs])
-        return float(np.linalg.norm(s - c) + n * np.linalg.norm(tgt - s))
-
-    guess = c + (tgt - c) * (zs - c[2]) / (tgt[2] - c[2])
-    sol = minimize(path, guess[:2], method="Nelder-Mead",
-                   options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000})
-    s_pt = np.array([sol.x[0], sol.x[1], zs])
-    l_air, l_g = float(np.linalg.norm(s_pt - c)), float(np.linalg.norm(tgt - s_pt))
-    cos_i = (zs - c[2]) / l_air
-    cos_t = (tgt[2] - zs) / l_g
-    sag = l_air + l_g / n
-    tan = l_air + l_g * cos_i**2 / (n * cos_t**2)
+    s_pt, sag, tan = _refracted_ray(medium, c, tgt)
+    l_air = float(np.linalg.norm(s_pt - c))
     eff = 0.5 * (sag + tan)
     ray = (s_pt - c) / l_air
     lam = C0 / frequency
@@ -265,3 +254,28 @@ def plan_oblique(aperture: object, source: object, medium: Medium, target: objec
         miss_h.append(True if sp is None else _miss(aperture, sp, refl) > 0)
     return ObliquePlan(spec, refl, float(miss), float(fraction), s_pt, float(eff), float(sag),
                        float(tan), res, tilts[np.array(miss_t)], heights[np.array(miss_h)])
+
+
+def _refracted_ray(medium: Medium, c: np.ndarray, tgt: np.ndarray
+                   ) -> tuple[np.ndarray, float, float]:
+    """Ray from ``c`` (air) to ``tgt`` (ground) through the layers: where it crosses
+    the surface, and its sagittal and tangential apparent distances (metres)."""
+    m_t = int(medium.region_of(tgt[2]))
+    tops = [float(c[2])] + [medium.z_interfaces[m] for m in range(m_t)]
+    bottoms = [*tops[1:], float(tgt[2])]
+    h = np.array(bottoms) - np.array(tops)                 # vertical run in each region
+    n = np.array([1.0] + [medium.n(m).real for m in range(1, m_t + 1)])
+    d_xy = tgt[:2] - c[:2]
+    dist = float(np.hypot(*d_xy))
+    u = d_xy / dist if dist > 0 else np.zeros(2)
+
+    def offset(s: float) -> float:   # horizontal run for sin(theta_air) = s
+        return float(np.sum(h * s / np.sqrt(n**2 - s**2))) - dist
+
+    s = brentq(offset, 0.0, 1 - 1e-15, xtol=1e-15) if dist > 0 else 0.0
+    cos_m = np.sqrt(1 - (s / n) ** 2)
+    lengths = h / cos_m
+    s_pt = np.array([*(c[:2] + u * h[0] * s / cos_m[0]), medium.z_interfaces[0]])
+    sag = float(np.sum(lengths / n))
+    tan = float(np.sum(lengths * cos_m[0] ** 2 / (n * cos_m**2)))
+    return s_pt, sag, tan

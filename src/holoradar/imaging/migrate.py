@@ -32,6 +32,7 @@ from ..physics.propagation import (
     ifft2_cropped,
     padded_shape,
 )
+from ..physics.sources import PlaneWave
 from . import kspace, oblique
 
 __all__ = ["IlluminationWarning", "migrate"]
@@ -202,7 +203,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     if frame == "ground":
         return _migrate_ground(hologram, zs, scalar, medium, method=method, pad=pad,
                                upsample=upsample, compensate_loss=compensate_loss,
-                               snr_db=snr_db, dtype=dtype, x=x, y=y)
+                               snr_db=snr_db, dtype=dtype, x=x, y=y, fov=fov)
     if medium is not None and pose.center[2] != 0.0 and not medium.is_free_space:
         # A level aperture at a height: the layers as seen from its plane.
         if pose.center[2] >= medium.z_interfaces[0]:
@@ -302,20 +303,30 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
 
 def _migrate_ground(hologram: Hologram, zs: np.ndarray, scalar: bool, medium: Medium | None, *,
                     method: str, pad: Any, upsample: Any, compensate_loss: bool,
-                    snr_db: Any, dtype: Any, x: Any, y: Any) -> Image:
+                    snr_db: Any, dtype: Any, x: Any, y: Any, fov: Any) -> Image:
     """``frame="ground"``: horizontal world planes through the layers."""
     if method != "angular":
         raise ValueError("frame='ground' uses the exact angular spectrum: method must be "
                          f"'angular', got {method!r}")
-    if isinstance(upsample, bool) or not float(upsample).is_integer() or int(upsample) < 1:
-        raise ValueError(f"upsample must be a whole number >= 1, got {upsample!r}")
+    if fov != "aperture":
+        raise ValueError("frame='ground' images the aperture's footprint or the x, y grids "
+                         f"given: fov must be 'aperture', got {fov!r}")
+    if not isinstance(upsample, int | np.integer) or isinstance(upsample, bool) \
+            or upsample < 1:
+        raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
+    if upsample != 1 and x is not None and y is not None:
+        raise ValueError("upsample sets the step of the default ground grid; with both x "
+                         "and y given it would be ignored: leave it at 1")
+    if dtype is not None and np.dtype(dtype) not in (np.complex64, np.complex128):
+        raise ValueError(f"dtype must be numpy.complex64 or numpy.complex128, got {dtype!r}")
     dx, dy = hologram.pitch
     warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram",
                     round_trip=hologram.monostatic)
     med = medium if medium is not None else Medium.free_space()
     gain = None
     if compensate_loss and not med.is_lossless:
-        gain = (as_real(snr_db, "snr_db") if snr_db is not None else DEFAULT_SNR_DB)
+        gain = (as_real(snr_db, "snr_db") if snr_db is not None
+                else _data_snr(hologram, med, zs))
     img = oblique.migrate_ground(hologram, zs, med, x=x, y=y, pad=pad,
                                  upsample=int(upsample), compensate_loss=gain, dtype=dtype)
     data = img.data[..., 0, :, :] if scalar else img.data
@@ -417,13 +428,9 @@ def _incident_phasor(source: Any, k: float, medium: Medium, img: Image,
     if pose is not None and not pose.is_identity:
         X, Y = np.meshgrid(img.x, img.y)
         pts = (pose.to_world(X, Y)[None] + img.z[:, None, None, None] * pose.normal)
-        if source is None:
-            # A plane wave at normal incidence: its transfer to each pixel's range.
-            zu, inv = np.unique(np.round(pts[..., 2], 12), return_inverse=True)
-            e0 = np.array([complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(z)))
-                           for z in zu])[inv].reshape(pts.shape[:-1])
-        else:
-            e0 = source.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
+        # No source: a plane wave at normal incidence (phase 0 at z = 0).
+        src = source if source is not None else PlaneWave()
+        e0 = src.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
         mag = np.abs(e0)
         return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
     if source is None:

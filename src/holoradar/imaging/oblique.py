@@ -73,7 +73,8 @@ def ground_grid(hologram: Hologram, zs: np.ndarray, medium: Medium,
         for c in corners:
             shift, top = 0.0, float(c[2])
             for m in range(medium.n_regions):
-                lo = max(top, medium.top_of(m))
+                # The air path runs from the corner itself (it may lie above z = 0).
+                lo = top if m == 0 else max(top, medium.top_of(m))
                 hi = min(z, medium.z_interfaces[m] if m < medium.n_regions - 1 else np.inf)
                 if hi > lo:
                     sin_t = min(s_air / medium.n(m).real, 0.999)
@@ -82,8 +83,9 @@ def ground_grid(hologram: Hologram, zs: np.ndarray, medium: Medium,
     ends = np.array(ends)
     step = min(hologram.pitch) / upsample
     lo, hi = ends.min(axis=0), ends.max(axis=0)
-    nx = int(np.floor((hi[0] - lo[0]) / step + 1e-9)) + 1
-    ny = int(np.floor((hi[1] - lo[1]) / step + 1e-9)) + 1
+    # ceil: the grid reaches the farthest corner's footprint.
+    nx = int(np.ceil((hi[0] - lo[0]) / step - 1e-9)) + 1
+    ny = int(np.ceil((hi[1] - lo[1]) / step - 1e-9)) + 1
     return lo[0] + step * np.arange(max(nx, 2)), lo[1] + step * np.arange(max(ny, 2))
 
 
@@ -123,9 +125,11 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
     gap = float(min(zs.min(), medium.z_interfaces[0] if not medium.is_free_space
                     else np.inf) - z_ref)
     kappa_max = np.hypot(kk, -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12))
-    ux = max(1, int(np.floor(np.pi / (kappa_max * dxw) + 1e-9)))
-    uy = max(1, int(np.floor(np.pi / (kappa_max * dyw) + 1e-9)))
-    dcx, dcy = ux * dxw, uy * dyw
+    # The grid's pitch is the output's times u (interpolated up) or divided by m
+    # (an output coarser than the spectrum needs: every m-th sample is kept).
+    ux, uy = (max(1, int(np.floor(np.pi / (kappa_max * d) + 1e-9))) for d in (dxw, dyw))
+    mx, my = (max(1, int(np.ceil(kappa_max * d / np.pi - 1e-9))) for d in (dxw, dyw))
+    dcx, dcy = ux * dxw / mx, uy * dyw / my
     # The world grid starts at the first output pixel and spans the output and the
     # elements (the grid is periodic: elements before the origin wrap, harmlessly,
     # as long as nothing overlaps), padded for the lateral travel down to z.
@@ -154,7 +158,11 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
     for j, z in enumerate(zs):
         Uc = _ground_transfer(grid, (dcx, dcy), k, shifted, float(z - z_ref), rise, mono,
                               reach, work, compensate_loss)
-        out[..., j, :, :] = _inverse_upsampled(H * Uc, (uy, ux), (yo.size, xo.size), workers)
+        full = _inverse_upsampled(H * Uc, (uy, ux), (my * (yo.size - 1) + 1,
+                                                      mx * (xo.size - 1) + 1), workers)
+        # ifft2 gives the kernel times the grid's cell area: scaled to the output's.
+        out[..., j, :, :] = full[..., ::my, ::mx] * (mx * my) if mx * my > 1 \
+            else full
     return Image(out, xo.copy(), yo.copy(), zs, hologram.frequency, "angular:ground")
 
 
@@ -213,9 +221,29 @@ def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float
         ap, aq = b.p[None, :], b.q[:, None]
         wx = _taper(ap * t, ap * (t + up), reach[0], Mx * dx - reach[0])
         wy = _taper(aq * t, aq * (t + up), reach[1], My * dy - reach[1])
-    mask = np.where(b.evanescent, 1.0, wx * wy).ravel()[b.unfold].reshape(grid)
+        # Evanescent across the air but travelling in the ground (a small air gap):
+        # they shift only in the ground, and alias as any other component would.
+        tg = _ground_travel(k, medium, b.kappa2, z, mono)
+        ge = _taper(ap * tg, ap * tg, reach[0], Mx * dx - reach[0]) \
+            * _taper(aq * tg, aq * tg, reach[1], My * dy - reach[1])
+    w_ev = np.where(np.isfinite(tg), ge, 1.0)      # 1: evanescent all the way down
+    mask = np.where(b.evanescent, w_ev, wx * wy).ravel()[b.unfold].reshape(grid)
     mask.setflags(write=False)
     return mask
+
+
+def _ground_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float,
+                   mono: bool) -> np.ndarray:
+    """:func:`lateral_travel` below the surface only (``inf`` where a component is
+    evanescent in a layer it crosses); a transceiver's components travel both ways."""
+    k2 = kappa2 / 4 if mono else kappa2
+    travel = np.zeros(np.shape(kappa2))
+    for m, h in medium.crossings(z):
+        if m == 0:
+            continue
+        kz = medium.kz(k, k2, m).real
+        travel = travel + np.where(kz > 0, h / np.where(kz > 0, kz, 1), np.inf)
+    return 0.5 * travel if mono else travel
 
 
 def _taper(low: np.ndarray, high: np.ndarray, needed: float, limit: float) -> np.ndarray:

@@ -79,6 +79,11 @@ class StreamImager:
                              f"{z!r}")
         if not isinstance(upsample, int | np.integer) or upsample < 1:
             raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
+        for i, v in enumerate(views):
+            if not v.pose.is_identity:
+                raise ValueError(f"views[{i}].pose must be the identity (a frontal array at "
+                                 f"z = 0) for streaming, got {v.pose!r}; image posed "
+                                 "holograms with synthesize(..., frame='ground')")
         h0 = views[0]
         self.k = h0.k
         self.shape = h0.data.shape[-2:]

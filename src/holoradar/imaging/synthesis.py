@@ -33,9 +33,8 @@ from typing import Literal
 import numpy as np
 
 from ..data.hologram import Hologram, Image
-from ..physics.incident import incident_on_planes
 from ..physics.medium import Medium
-from .migrate import migrate
+from .migrate import _incident_phasor, migrate
 
 __all__ = ["align_phases", "synthesize"]
 
@@ -197,10 +196,10 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     k = views[0].k
     aligned = np.empty_like(g)
     for i, v in enumerate(views):
-        e0 = incident_on_planes(v.source, k, med, img.x, img.y, img.z)
-        mag = np.abs(e0)
-        # conj(E0)/|E0|: the unit phasor of the incident field (0 where it vanishes)
-        aligned[i] = g[i] * np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
+        # conj(E0)/|E0|, the unit phasor of the incident field (0 where it vanishes),
+        # at the pixels' world positions (a raised or shifted level view included).
+        aligned[i] = g[i] * _incident_phasor(v.source, k, med, img,
+                                             None if frame == "ground" else v.pose)
     return _combine(aligned, img, mode, return_views)
 
 

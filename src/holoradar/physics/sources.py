@@ -79,9 +79,14 @@ class PlaneWave:
         k2 = np.array(p0 * p0 + q0 * q0)
         lateral = np.exp(1j * (p0 * pts[:, 0] + q0 * pts[:, 1]))
         out = np.empty(len(pts), complex)
+        kz0 = medium.kz(k, k2, 0)
         for z in np.unique(pts[:, 2]):
             sel = pts[:, 2] == z
-            out[sel] = lateral[sel] * medium.vertical_transfer(k, k2, 0.0, float(z))
+            # Above the reference plane (z < 0, a raised or tilted aperture) the wave
+            # has not reached z = 0 yet: its phase lags, exp(i*kz0*z) with z < 0.
+            t = (np.exp(1j * kz0 * z) if z < 0
+                 else medium.vertical_transfer(k, k2, 0.0, float(z)))
+            out[sel] = lateral[sel] * t
         return out
 
     def reflected(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
