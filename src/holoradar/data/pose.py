@@ -126,6 +126,19 @@ class Pose:
         xl, yl = np.broadcast_arrays(np.asarray(xl, float), np.asarray(yl, float))
         return (np.asarray(self.center) + xl[..., None] * self.u + yl[..., None] * self.v)
 
+    def to_local(self, points: np.ndarray) -> np.ndarray:
+        """Coordinates (..., 3) of world points in the aperture's frame: along its
+        x and y axes and along its normal (``z'`` > 0 on the side it faces).
+
+        Examples
+        --------
+        >>> p = Pose((0.0, 0.0, 0.1), tilt=np.radians(30))
+        >>> [round(float(v), 6) for v in p.to_local(p.center + 0.2 * p.normal + 0.05 * p.u)]
+        [0.05, 0.0, 0.2]
+        """
+        d = np.asarray(points, float) - np.asarray(self.center)
+        return np.stack([d @ self.u, d @ self.v, d @ self.normal], axis=-1)
+
     def grid_points(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """World positions (ny, nx, 3) of a grid of element coordinates."""
         X, Y = np.meshgrid(np.asarray(x, float), np.asarray(y, float))

@@ -42,7 +42,7 @@ from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
-from scipy.optimize import least_squares
+from scipy.optimize import brentq, least_squares
 
 from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram
@@ -246,15 +246,6 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     >>> rep.glare_suppression_db > 20
     True
     """
-    if isinstance(hologram, Hologram) and not hologram.pose.is_identity \
-            and method != "background":
-        # The glare models (mirror image, Gaussian fit in its plane) assume the
-        # aperture on z = 0 facing the ground. A tilted array avoids the glare by
-        # geometry: plan_oblique says how much of it still reaches the elements.
-        raise ValueError("hologram.pose: suppress_surface models an aperture on z = 0 "
-                         "facing the ground; for a posed (tilted or raised) aperture use "
-                         "method='background' (a measured empty scene), or keep the glare "
-                         "out by the layout (holoradar.plan_oblique)")
     src = source if source is not None else getattr(hologram, "source", None)
     if src is None and method != "background":
         raise ValueError("source must be given (the radiator as a PointSource), or carried "
@@ -270,6 +261,17 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                              f"report (keys {sorted(need)}), got {initial!r}")
     z_m = _check(hologram, medium, src, method)
     data = hologram.data
+    pose = hologram.pose
+    if method != "background":
+        # Everything below happens in the aperture's own frame (x, y along its
+        # axes, z' along its normal): the mirror image's spherical wave focuses, in
+        # free space, at its own coordinates there, for any tilt.
+        mirror_local = pose.to_local(src.mirror_position(medium))
+        z_m = float(mirror_local[2])
+        if z_m <= 0:
+            raise ValueError("hologram.pose: the source's mirror image in the surface lies "
+                             "behind the aperture's plane, where no image of it forms; "
+                             "use method='background'")
     if method == "background":
         if not isinstance(background, Hologram):
             raise ValueError("background must be the empty-scene Hologram for method "
@@ -287,11 +289,13 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     if data.ndim != 2:
         raise ValueError(f"suppress_surface takes one view (ny, nx), got shape {data.shape}")
     k = hologram.k
-    pts = hologram.points
+    pts = hologram.points                      # world: the direct wave, the image source
+    X, Y = np.meshgrid(hologram.x, hologram.y)
+    local = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)   # the beam fit
     op = _mirror_operator(hologram, z_m)
     A = hologram.aperture_size
     cell = lateral_resolution(hologram.wavelength, z_m, min(A))
-    predicted = np.array([src.position[0], src.position[1]])
+    predicted = mirror_local[:2]
     E_before = _mirror_image(op, data)
     xs, ys, peak_before = _find_spot(hologram, op, E_before, predicted, 3 * cell)
     D = _direct_wave(src, k, pts) if direct else None
@@ -310,7 +314,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                                   * op.transfers[0], workers=op.workers)
         glare = removed_grid[:data.shape[0], :data.shape[1]].ravel()
         dcoef, glare, direct_part = _joint_direct(h, glare, D)
-        report_kw.update(mirror_position=(xs, ys, z_m), waist=r, amplitude=None)
+        report_kw.update(mirror_position=_world(pose, xs, ys, z_m), waist=r, amplitude=None)
         converged, params = True, {"x": xs, "y": ys}
     elif method == "gaussian":
         transform = None
@@ -321,10 +325,10 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
             def transform(v: np.ndarray) -> np.ndarray:
                 return _mirror_image(op, v.reshape(data.shape))[window]
 
-        glare, direct_part, dcoef, fit = _fit_gaussian(k, pts, h, D, xs, ys, z_m, cell, initial,
-                                                       transform)
+        glare, direct_part, dcoef, fit = _fit_gaussian(k, local, h, D, xs, ys, z_m, cell,
+                                                       initial, transform)
         xc, yc, zc, b = fit["x"], fit["y"], fit["z"], fit["b"]
-        report_kw.update(mirror_position=(xc, yc, zc), amplitude=fit["a"],
+        report_kw.update(mirror_position=_world(pose, xc, yc, zc), amplitude=fit["a"],
                          phase=float(np.angle(fit["a"])), waist=float(np.sqrt(2 * b / k)))
         converged, params = fit["converged"], fit
     else:  # image_source
@@ -355,7 +359,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         if ref is None:
             ref = src.amplitude
         V, eps = _eps_from_gaussian(report_kw["amplitude"], params["b"], complex(ref), src,
-                                    hologram, z_m, k)
+                                    hologram, medium, k)
         if not np.isfinite(eps.real):
             warnings.warn("suppress_surface: the glare is stronger than the reference "
                           "amplitude allows (|V| >= 1): give reference_amplitude (a "
@@ -536,9 +540,17 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
     return a * G, (np.zeros_like(h) if D is None else a * D), dcoef, fit
 
 
+def _world(pose: Any, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """A point of the aperture's frame (x, y along its axes, z along its normal) in
+    the world."""
+    w = pose.to_world(np.array(x), np.array(y)) + z * pose.normal
+    return float(w[0]), float(w[1]), float(w[2])
+
+
 def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
-                       hologram: Hologram, z_m: float, k: float) -> tuple[complex, complex]:
-    """V and eps from the mirror spot's strength, near-normal incidence.
+                       hologram: Hologram, medium: Medium, k: float
+                       ) -> tuple[complex, complex]:
+    """V and eps from the mirror spot's strength.
 
     The fitted beam ``a*exp(ik Rc)/Rc``, ``Rc ~ s - i*b`` on its axis, is the mirror
     image's spherical wave ``V * ref * pattern * exp(iks)/s`` for a source of
@@ -547,10 +559,17 @@ def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
     centre. Its phase is traded against the fitted range of the beam (a
     millimetre is 0.2 rad), so only |V| is used: for a ground denser than air
     V = -|V| and n = (1 + |V|)/(1 - |V|), real (loss is not seen this way).
+
+    A posed (tilted or shifted) aperture sees the surface at the specular angle
+    theta of the ray to its centre: eps' then solves ``|r(eps', theta)| = |V|``
+    for the medium's polarization (Fresnel, a half-space), monotonic in eps'.
     """
+    z0 = medium.z_interfaces[0]
+    centre = hologram.pose.to_world(np.array(np.mean(hologram.x)),
+                                    np.array(np.mean(hologram.y)))
     # The ray leaves the radiator towards the aperture centre's mirror point, downwards.
-    d = np.array([np.mean(hologram.x) - src.position[0], np.mean(hologram.y) - src.position[1],
-                  z_m - src.position[2]])
+    d = np.array([centre[0] - src.position[0], centre[1] - src.position[1],
+                  2 * z0 - centre[2] - src.position[2]])
     d /= np.linalg.norm(d)
     pat = src.pattern(d[None, :])[0] if src.has_pattern else 1.0
     if pat == 0:
@@ -558,8 +577,18 @@ def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
     V = -abs(a * np.exp(k * b) / (ref * pat))
     if V <= -1:
         return complex(V), complex(np.nan)
-    n = (1 - V) / (1 + V)
-    return complex(V), complex(n * n)
+    if hologram.pose.is_identity:
+        n = (1 - V) / (1 + V)
+        return complex(V), complex(n * n)
+    kappa2 = np.array(k * k * (1 - d[2] ** 2))
+
+    def excess(e: float) -> float:
+        half = Medium((z0,), (1.0, e), medium.polarization)
+        return float(abs(half.reflection(k, kappa2))) - abs(V)
+
+    if excess(1.0 + 1e-9) >= 0 or excess(1e4) <= 0:
+        return complex(V), complex(np.nan)
+    return complex(V), complex(brentq(excess, 1.0 + 1e-9, 1e4, xtol=1e-10))
 
 
 def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None, *,
