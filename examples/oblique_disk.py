@@ -34,17 +34,18 @@ DEPTH = 0.41
 def scene_views(y0s: np.ndarray, sides: tuple[float, ...] = (-0.25, 0.25),
                 pixel: float = 0.003, *, medium: hr.Medium | None = None,
                 depth: float = DEPTH, tilt_deg: float = 35.0, snr_db: float | None = None,
-                include_surface: bool = False,
-                pattern: float = 4.0) -> tuple[list[hr.Hologram], hr.Medium]:
+                include_surface: bool = False, pattern: float = 4.0,
+                distance: float = 0.35) -> tuple[list[hr.Hologram], hr.Medium]:
     """The views of the disk, one per horn position (x = side, y = y0), the horn
-    5 cm above the surface (default: sand at 0.30 m)."""
+    5 cm above the surface (default: sand at 0.30 m), the array's centre
+    ``distance`` from the disk's centre along its normal."""
     ground = medium if medium is not None else hr.Medium.half_space(0.30, 2.5 + 0.0125j)
     surface = ground.z_interfaces[0]
     disk = hr.PlanarTarget.from_shape("disk", depth, diameter=DIAMETER, reflection=-1.0,
                                       pixel=pixel)
     t = np.radians(tilt_deg)
     normal = np.array([0.0, np.sin(t), np.cos(t)])
-    pose = hr.Pose(tuple(np.array([0, 0, depth]) - 0.35 * normal), tilt=t,
+    pose = hr.Pose(tuple(np.array([0, 0, depth]) - distance * normal), tilt=t,
                    azimuth=np.radians(90))
     ap = hr.Aperture.grid(16, 0.025, pose=pose)
     views = []
