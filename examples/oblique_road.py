@@ -48,7 +48,7 @@ import holoradar as hr
 from holoradar.analysis.metrics import circle_fit
 
 sys.path.insert(0, str(Path(__file__).parent))
-from oblique_disk import DIAMETER, scene_views  # noqa: E402
+from oblique_disk import DIAMETER, scene_views
 
 SURFACE = 0.30
 DEPTH = 0.40            # the disk 10 cm under the road's surface
