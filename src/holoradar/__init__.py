@@ -30,6 +30,7 @@ from .imaging.reflection import (
 )
 from .imaging.stream import StreamImager
 from .imaging.synthesis import align_phases, synthesize
+from .io import load, save
 from .model.scene import Aperture, Scene
 from .model.simulate import simulate
 from .model.targets import PlanarTarget, PointTarget
@@ -66,10 +67,12 @@ __all__ = [
     "conjugate",
     "estimate_permittivity",
     "iq_convention",
+    "load",
     "migrate",
     "permittivity",
     "plan_oblique",
     "remove_mean",
+    "save",
     "simulate",
     "suppress_surface",
     "synthesize",

@@ -1,0 +1,234 @@
+"""Holograms and images as NetCDF-4 files (xarray + h5netcdf), readable by any NetCDF tool.
+
+Layout of a file:
+
+* one data variable, ``hologram`` or ``image``, real, with a last dimension
+  ``iq`` of size 2: index 0 the in-phase part I, index 1 the quadrature Q, the
+  complex sample being ``I + iQ`` (time dependence ``exp(-i omega t)``); no
+  complex type is needed to read it;
+* its other dimensions: leading frames ``frame0``, ``frame1``, ... , then
+  ``frequency`` (a wideband hologram), ``z`` (an image with planes), ``y``, ``x``;
+* coordinates in metres and hertz with CF ``units`` and ``long_name``: ``x``,
+  ``y`` (element coordinates in the aperture's own plane; image pixels in the
+  image's frame), ``z`` (ranges of an image's planes), ``frequency`` (always a
+  1-D variable; ``wideband`` says whether it is an axis);
+* global attributes: ``holoradar_kind`` (``Hologram`` or ``Image``),
+  ``holoradar_conventions`` (the version of these conventions), ``monostatic``,
+  the pose (``pose_center_m``, ``pose_tilt_rad``, ``pose_azimuth_rad``), the
+  source as JSON (``source``), the image's ``method`` and ``has_z_axis``, and a
+  processing ``history`` (JSON list of steps: name, parameters, holoradar's
+  version, UTC time).
+
+Reading parses numbers and JSON only: nothing is unpickled or evaluated.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..data.hologram import Hologram, Image
+from ..data.pose import Pose
+from ..physics.sources import GaussianBeam, PlaneWave, PointSource
+
+__all__ = ["CONVENTIONS", "from_dataset", "read_history", "to_dataset"]
+
+CONVENTIONS = "1"
+_SOURCES = {cls.__name__: cls for cls in (PlaneWave, PointSource, GaussianBeam)}
+
+
+def _version() -> str:
+    from .. import __version__
+
+    return __version__
+
+
+def _jsonable(v: Any) -> Any:
+    if isinstance(v, np.ndarray):
+        return [_jsonable(e) for e in v.tolist()]
+    if isinstance(v, complex | np.complexfloating):
+        return {"re": float(np.real(v)), "im": float(np.imag(v))}
+    if isinstance(v, np.bool_ | bool):
+        return bool(v)
+    if isinstance(v, np.floating | np.integer):
+        return v.item()
+    if isinstance(v, list | tuple):
+        return [_jsonable(e) for e in v]
+    return v
+
+
+def source_to_json(source: Any) -> str | None:
+    """The source as JSON text (its type and fields), or None."""
+    if source is None:
+        return None
+    if type(source).__name__ not in _SOURCES:
+        raise ValueError(f"source of type {type(source).__name__} cannot be saved")
+    fields = {f.name: _jsonable(getattr(source, f.name)) for f in dataclasses.fields(source)}
+    return json.dumps({"type": type(source).__name__, **fields})
+
+
+def source_from_json(text: str) -> Any:
+    """Rebuild a source from :func:`source_to_json`'s text (known types only)."""
+    try:
+        spec = json.loads(text)
+        cls = _SOURCES[spec.pop("type")]
+        names = {f.name for f in dataclasses.fields(cls)}
+        kw = {}
+        for k, v in spec.items():
+            if k not in names:
+                raise KeyError(k)
+            if isinstance(v, dict) and set(v) == {"re", "im"}:
+                v = complex(v["re"], v["im"])
+            kw[k] = v
+        out = cls(**kw)
+        for k in ("axis", "position", "center"):
+            # Stored exactly as the source held them (already normalised): set them
+            # back bit for bit, after the constructor has validated them.
+            if k in kw and hasattr(out, k):
+                stored = np.asarray(kw[k], float)
+                if stored.shape != np.shape(getattr(out, k)) or not np.allclose(
+                        stored, getattr(out, k), rtol=1e-12, atol=1e-15):
+                    raise ValueError(f"{k} {kw[k]!r} is not in normal form")
+                object.__setattr__(out, k, stored)
+        return out
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise ValueError(f"the file's 'source' attribute is not a holoradar source: {exc}; "
+                         f"known types {sorted(_SOURCES)}") from None
+
+
+def _split_iq(data: np.ndarray) -> np.ndarray:
+    real = np.float32 if data.dtype == np.complex64 else np.float64
+    return np.stack([data.real, data.imag], axis=-1).astype(real, copy=False)
+
+
+def _coord(values: np.ndarray, dim: str, units: str, long_name: str) -> Any:
+    import xarray as xr
+
+    return xr.Variable((dim,), np.asarray(values, float), {"units": units,
+                                                          "long_name": long_name})
+
+
+def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = None) -> Any:
+    """An ``xarray.Dataset`` holding ``obj`` (see the module text for the layout).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = Hologram(np.ones((2, 3)), [0.0, 0.01, 0.02], [0.0, 0.01], 9.9e9)
+    >>> ds = to_dataset(h)
+    >>> ds["hologram"].dims, ds.attrs["holoradar_kind"]
+    (('y', 'x', 'iq'), 'Hologram')
+    """
+    import xarray as xr
+
+    steps = list(history or [])
+    attrs: dict[str, Any] = {"Conventions": "CF-1.8", "holoradar_conventions": CONVENTIONS,
+                             "holoradar_version": _version(),
+                             "iq_convention": "sample = I + iQ (iq index 0, 1); time "
+                                              "dependence exp(-i omega t)"}
+    coords: dict[str, Any] = {
+        "iq": xr.Variable(("iq",), np.array(["I", "Q"]), {"long_name": "in-phase, quadrature"}),
+        "frequency": _coord(np.atleast_1d(obj.frequency), "frequency", "Hz", "frequency"),
+    }
+    if isinstance(obj, Hologram):
+        kind, var = "Hologram", "hologram"
+        core = (["frequency"] if obj.is_wideband else []) + ["y", "x"]
+        coords["x"] = _coord(obj.x, "x", "m", "element x in the aperture's own plane")
+        coords["y"] = _coord(obj.y, "y", "m", "element y in the aperture's own plane")
+        p = obj.pose
+        attrs.update(monostatic=int(obj.monostatic), wideband=int(obj.is_wideband),
+                     pose_center_m=np.asarray(p.center, float), pose_tilt_rad=float(p.tilt),
+                     pose_azimuth_rad=float(p.azimuth))
+        src = source_to_json(obj.source)
+        if src is not None:
+            attrs["source"] = src
+        long_name = "received field at the elements"
+    elif isinstance(obj, Image):
+        kind, var = "Image", "image"
+        core = (["z"] if obj.has_z_axis else []) + ["y", "x"]
+        coords["x"] = _coord(obj.x, "x", "m", "pixel x")
+        coords["y"] = _coord(obj.y, "y", "m", "pixel y")
+        coords["z"] = _coord(obj.z, "z", "m", "range of the image planes")
+        attrs.update(method=str(obj.method), has_z_axis=int(obj.has_z_axis),
+                     wideband=int(isinstance(obj.frequency, np.ndarray)))
+        long_name = "reconstructed field"
+    else:
+        raise ValueError(f"obj must be a holoradar.Hologram or holoradar.Image, got "
+                         f"{type(obj).__name__}")
+    data = np.asarray(obj.data)
+    lead = [f"frame{i}" for i in range(data.ndim - len(core))]
+    steps.append({"step": "save", "parameters": {"kind": kind}, "holoradar": _version(),
+                  "time": datetime.now(UTC).isoformat(timespec="seconds")})
+    attrs["holoradar_kind"] = kind
+    attrs["history"] = json.dumps(steps)
+    values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
+                         {"long_name": long_name, "units": "1"})
+    return xr.Dataset({var: values}, coords=coords, attrs=attrs)
+
+
+def _need(ds: Any, names: list[str], what: str) -> None:
+    missing = [n for n in names if n not in ds.variables and n not in ds.attrs]
+    if missing:
+        found = sorted(list(ds.variables) + list(ds.attrs))
+        raise ValueError(f"{what}: missing {missing}; found {found}")
+
+
+def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
+    """Rebuild the Hologram or Image that :func:`to_dataset` stored."""
+    kind = ds.attrs.get("holoradar_kind")
+    if kind not in ("Hologram", "Image"):
+        raise ValueError(f"{what} is not a holoradar file (no holoradar_kind attribute "
+                         "'Hologram' or 'Image'); found variables "
+                         f"{sorted(ds.variables)} (it was not written by holoradar.save)")
+    var = kind.lower()
+    _need(ds, [var, "x", "y", "frequency"], what)
+    arr = ds[var]
+    if arr.dims[-1] != "iq" or arr.shape[-1] != 2:
+        raise ValueError(f"{what}: variable {var!r} must end in a dimension 'iq' of size 2 "
+                         f"(I, Q), got dims {arr.dims} and shape {arr.shape}")
+    raw = np.asarray(arr.values)
+    if not np.issubdtype(raw.dtype, np.floating):
+        raise ValueError(f"{what}: variable {var!r} must be real numbers, got {raw.dtype}")
+    data = raw[..., 0] + 1j * raw[..., 1]
+    if raw.dtype == np.float32:
+        data = data.astype(np.complex64)
+    x, y = np.asarray(ds["x"].values, float), np.asarray(ds["y"].values, float)
+    f = np.asarray(ds["frequency"].values, float).ravel()
+    wideband = bool(int(ds.attrs.get("wideband", f.size > 1)))
+    freq: Any = f if wideband else (float(f[0]) if f.size == 1 else f)
+    if kind == "Hologram":
+        center = np.asarray(ds.attrs.get("pose_center_m", [0.0, 0.0, 0.0]), float).ravel()
+        if center.size != 3:
+            raise ValueError(f"{what}: pose_center_m must hold 3 numbers, got {center.size}")
+        pose = Pose(tuple(float(c) for c in center), float(ds.attrs.get("pose_tilt_rad", 0.0)),
+                    float(ds.attrs.get("pose_azimuth_rad", 0.0)))
+        src = ds.attrs.get("source")
+        return Hologram(data, x, y, freq,
+                        source=None if src is None else source_from_json(str(src)),
+                        monostatic=bool(int(ds.attrs.get("monostatic", 0))),
+                        pose=None if pose.is_identity else pose)
+    _need(ds, ["z"], what)
+    has_z = bool(int(ds.attrs.get("has_z_axis", 1)))
+    z = np.asarray(ds["z"].values, float).ravel()
+    need = (z.size,) if has_z else ()
+    if data.shape[-2:] != (y.size, x.size) or (has_z and data.shape[-3:-2] != need):
+        raise ValueError(f"{what}: image of shape {data.shape} does not match z {z.size}, "
+                         f"y {y.size}, x {x.size}")
+    return Image(data, x, y, z, freq, str(ds.attrs.get("method", "angular")), has_z_axis=has_z)
+
+
+def read_history(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The processing history stored in a holoradar NetCDF file (a list of steps)."""
+    import xarray as xr
+
+    with xr.open_dataset(Path(path), engine="h5netcdf") as ds:
+        try:
+            return list(json.loads(ds.attrs.get("history", "[]")))
+        except ValueError:
+            raise ValueError(f"{path}: the history attribute is not JSON") from None

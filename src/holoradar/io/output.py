@@ -1,0 +1,83 @@
+"""Safe output files: never an input, never an existing file unless asked, the folder
+checked before any work, written atomically with the user's umask."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+__all__ = ["check_output", "default_mode", "write_via_temp"]
+
+
+def default_mode() -> int:
+    """Permission bits a new file gets from ``open()``: ``0o666`` less the umask.
+
+    Temporary files are created 0600; the finished file is given these bits so
+    that it looks like any other file the user writes.
+    """
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
+                 inputs: Iterable[str | os.PathLike[str]] = (), overwrite: bool = False,
+                 name: str = "path") -> Path:
+    """Validate an output path before any computation; return it as a ``Path``.
+
+    Raises
+    ------
+    ValueError
+        The suffix does not match the format, the path is one of the inputs, it
+        exists and ``overwrite`` is False, or its folder does not exist.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> check_output(d / "a.nc", suffixes=[".nc"]).name
+    'a.nc'
+    >>> check_output(d / "a.png", suffixes=[".nc"])
+    Traceback (most recent call last):
+    ...
+    ValueError: path must end in .nc for this format, got 'a.png'
+    """
+    target = Path(path)
+    allowed = [s.lower() for s in suffixes]
+    if not any(target.name.lower().endswith(s) for s in allowed):
+        raise ValueError(f"{name} must end in {' or '.join(allowed)} for this format, got "
+                         f"{target.name!r}")
+    for src in inputs:
+        try:
+            same = Path(src).resolve() == target.resolve()
+        except OSError:
+            same = False
+        if same:
+            raise ValueError(f"{name} {str(target)!r} is one of the inputs: refusing to replace "
+                             "the data it was computed from")
+    if not target.parent.is_dir():
+        raise ValueError(f"{name}: the folder {str(target.parent)!r} does not exist")
+    if target.exists() and not overwrite:
+        raise ValueError(f"{name} {str(target)!r} exists: pass overwrite=True (--force on the "
+                         "command line) to replace it")
+    return target
+
+
+def write_via_temp(target: Path, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp)`` on a temporary file beside ``target``, then rename it onto
+    ``target`` with the user's umask; on failure nothing is left behind."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        write(tmp_path)
+        with open(tmp_path, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.chmod(tmp_path, default_mode())
+        os.replace(tmp_path, target)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+    return target
