@@ -39,6 +39,12 @@ def test_demo_writes_labelled_figures_and_summary(tmp_path):
                                                           "mirror_image_expected_m"))
     assert np.hypot(*(found[:2] - expected[:2])) < lam * expected[2] / 0.40 / 4
     assert not list(out.glob(".*tmp"))
+    # The README's next command images the demo's own hologram.
+    res = CliRunner().invoke(main, ["image", str(out / "hologram.nc"), "--z",
+                                    "0.30:0.60:0.005", "--eps", "2.5+0.0125j", "--z-surface",
+                                    "0.30", "--out", str(tmp_path / "img.nc")])
+    assert res.exit_code == 0, res.output
+    assert isinstance(hr.load(tmp_path / "img.nc"), hr.Image)
 
 
 def test_image_command_roundtrip(tmp_path):
@@ -87,3 +93,34 @@ def test_plan_oblique_command(tmp_path):
     bad = tmp_path / "bad.png"
     res = CliRunner().invoke(main, ["plan-oblique", "--horn", "0,0,0.35", "--out", str(bad)])
     assert res.exit_code == 2 and "source" in res.output and not bad.exists()
+
+
+def test_image_command_reads_and_writes_netcdf_and_never_destroys_data(tmp_path):
+    """A hologram saved by holoradar.save is imaged from the command line into an
+    image file that holoradar.load reads; the output may not be the input, an
+    existing output needs --force, a missing folder or a bad --z fails before any
+    work (exit code 2, one line, nothing written)."""
+    scene = hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))])
+    src = hr.save(hr.simulate(scene, hr.Aperture.grid(64, 0.01), F0), tmp_path / "holo.nc")
+    before = src.read_bytes()
+    out = tmp_path / "img.nc"
+    run = CliRunner().invoke
+    res = run(main, ["image", str(src), "--z", "0.25:0.35:0.01", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    img = hr.load(out)
+    assert isinstance(img, hr.Image) and abs(img.peak()[2] - 0.3) < 0.01
+    assert hr.io.read_history(out)[0]["step"] == "migrate"
+    res = run(main, ["image", str(src), "--z", "0.3", "--out", str(src)])
+    assert res.exit_code == 2 and "one of the inputs" in res.output
+    res = run(main, ["image", str(src), "--z", "0.3", "--out", str(out)])
+    assert res.exit_code == 2 and "--force" in res.output
+    assert run(main, ["image", str(src), "--z", "0.3", "--out", str(out), "--force"]
+               ).exit_code == 0
+    res = run(main, ["image", str(src), "--z", "0.3", "--out", str(tmp_path / "no" / "i.nc")])
+    assert res.exit_code == 2 and "does not exist" in res.output
+    res = run(main, ["image", str(src), "--z", "0.3:0.6:0", "--out", str(tmp_path / "j.nc")])
+    assert res.exit_code == 2 and "step > 0" in res.output
+    res = run(main, ["image", str(src), "--z", "0.3", "--out", str(tmp_path / "k.png")])
+    assert res.exit_code == 2 and ".nc or .npz" in res.output
+    assert src.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["holo.nc", "img.nc", "img.png"]

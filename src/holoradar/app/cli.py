@@ -61,48 +61,88 @@ def demo(out: Path, upsample: int) -> None:
               show_default=True)
 @click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32))
 @click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
-              help="Output .npz (image) ; a PNG of the brightest plane is written beside it.")
+              help="Output image: .nc (NetCDF-4, holoradar.load reads it) or .npz; a PNG "
+                   "of the brightest plane is written beside it.")
+@click.option("--force", is_flag=True, help="Replace existing output files.")
 def image(hologram_file: Path, z: str, eps: str | None, z_surface: float | None, method: str,
-          upsample: int, out: Path) -> None:
-    """Migrate a hologram stored as .npz (keys data, x, y, frequency) to range(s) Z."""
+          upsample: int, out: Path, force: bool) -> None:
+    """Migrate a hologram to range(s) Z.
+
+    HOLOGRAM_FILE: a .nc file written by holoradar (holoradar.save, holoradar
+    demo), or an .npz with the keys data (complex, ny x nx), x, y (metres) and
+    frequency (Hz).
+    """
     from ..data.hologram import Hologram
     from ..imaging.migrate import migrate
+    from ..io import load, save
+    from ..io.output import check_output
     from ..physics.medium import Medium
     from . import plotting
     from .atomic import write_atomic
 
-    try:
-        zs: float | np.ndarray
-        if ":" in z:
-            a, b, st = (float(v) for v in z.split(":"))
-            zs = np.arange(a, b + st / 2, st)
-        else:
-            zs = float(z)
-    except ValueError:
-        raise click.BadParameter("expected a range in metres or start:stop:step",
-                                 param_hint="--z") from None
+    zs = _ranges(z)
     if (eps is None) != (z_surface is None):
         raise click.BadParameter("give both --eps and --z-surface, or neither",
                                  param_hint="--eps/--z-surface")
     try:
-        with np.load(hologram_file) as d:
-            holo = Hologram(d["data"], d["x"], d["y"], float(d["frequency"]))
+        # Outputs are checked before any work: never an input, never replaced unasked.
+        check_output(out, suffixes=[".nc", ".npz"], inputs=[hologram_file], overwrite=force,
+                     name="--out")
+        check_output(out.with_suffix(".png"), suffixes=[".png"], inputs=[hologram_file],
+                     overwrite=force, name="--out's PNG")
+        if hologram_file.suffix.lower() == ".npz":
+            with np.load(hologram_file, allow_pickle=False) as d:
+                holo = Hologram(d["data"], d["x"], d["y"], float(d["frequency"]))
+        else:
+            holo = load(hologram_file)
+            if not isinstance(holo, Hologram):
+                raise ValueError(f"{hologram_file.name} holds an image, not a hologram")
         medium = None if eps is None else Medium.half_space(z_surface, complex(eps))
         img = migrate(holo, zs, medium=medium, method=method, upsample=upsample)
-    except (KeyError, ValueError) as exc:
+    except KeyError as exc:
+        click.echo(f"error: {hologram_file.name} lacks the key {exc} (an .npz needs data, x, "
+                   "y, frequency)", err=True)
+        sys.exit(2)
+    except ValueError as exc:
         click.echo(f"error: {exc}", err=True)
         sys.exit(2)
-    import io
-
-    buf = io.BytesIO()
-    np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency)
     from ..analysis.metrics import peak_position
 
     pk = peak_position(img)
     fig = plotting.plot_image([img.plane(pk[2])], [f"{hologram_file.name} ({method})"])
-    write_atomic(out, buf.getvalue())
+    if out.suffix.lower() == ".nc":
+        save(img, out, overwrite=force,
+             history=[{"step": "migrate", "parameters": {"z": z, "eps": eps,
+                                                         "z_surface": z_surface,
+                                                         "method": method,
+                                                         "upsample": upsample},
+                       "input": hologram_file.name}])
+    else:
+        import io
+
+        buf = io.BytesIO()
+        np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency)
+        write_atomic(out, buf.getvalue())
     write_atomic(out.with_suffix(".png"), plotting.to_png(fig))
     click.echo(json.dumps({"peak_m": pk, "out": str(out)}))
+
+
+def _ranges(text: str) -> float | np.ndarray:
+    """``0.4`` or ``start:stop:step`` (metres, step > 0, stop >= start)."""
+    try:
+        if ":" not in text:
+            return float(text)
+        a, b, st = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise click.BadParameter(f"expected a range in metres or start:stop:step, got {text!r}",
+                                 param_hint="--z") from None
+    if not (np.isfinite([a, b, st]).all() and st > 0 and b >= a):
+        raise click.BadParameter(f"start:stop:step needs step > 0 and stop >= start, got "
+                                 f"{text!r}", param_hint="--z")
+    if (b - a) / st > 100000:
+        raise click.BadParameter(f"{text!r} asks for more than 100000 planes",
+                                 param_hint="--z")
+    return np.arange(a, b + st / 2, st)
 
 
 def _triple(text: str, name: str) -> tuple[float, float, float]:

@@ -154,6 +154,12 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         outdir.mkdir(parents=True, exist_ok=True)
         for name, payload in pngs.items():
             write_atomic(outdir / name, payload)
-        summary["files"] = sorted([*pngs, "summary.json"])
+        # The hologram too, so that `holoradar image demo_out/hologram.nc ...` works; the
+        # demo's folder is its own: a rerun replaces what it wrote there.
+        from ..io import save
+
+        save(holo, outdir / "hologram.nc", overwrite=True,
+             history=[{"step": "simulate", "parameters": {"scene": "demo: letter R in sand"}}])
+        summary["files"] = sorted([*pngs, "hologram.nc", "summary.json"])
         write_atomic(outdir / "summary.json", json.dumps(summary, indent=2).encode())
     return summary
