@@ -425,19 +425,14 @@ def _incident_phasor(source: Any, k: float, medium: Medium, img: Image,
     incidence without a source. ``pose``: the image is in that aperture's own frame
     (planes parallel to it at distances z); the incident field is taken at the
     pixels' world positions."""
+    # No source: a plane wave at normal incidence (phase 0 at z = 0).
+    src = source if source is not None else PlaneWave()
     if pose is not None and not pose.is_identity:
         X, Y = np.meshgrid(img.x, img.y)
         pts = (pose.to_world(X, Y)[None] + img.z[:, None, None, None] * pose.normal)
-        # No source: a plane wave at normal incidence (phase 0 at z = 0).
-        src = source if source is not None else PlaneWave()
         e0 = src.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
-        mag = np.abs(e0)
-        return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
-    if source is None:
-        e0 = np.array([complex(medium.vertical_transfer(k, np.array(0.0), 0.0, float(zj)))
-                       for zj in img.z])[:, None, None] * np.ones((1, img.y.size, img.x.size))
     else:
-        e0 = incident_on_planes(source, k, medium, img.x, img.y, img.z)
+        e0 = incident_on_planes(src, k, medium, img.x, img.y, img.z)
     mag = np.abs(e0)
     return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
 

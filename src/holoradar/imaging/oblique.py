@@ -223,27 +223,14 @@ def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float
         wy = _taper(aq * t, aq * (t + up), reach[1], My * dy - reach[1])
         # Evanescent across the air but travelling in the ground (a small air gap):
         # they shift only in the ground, and alias as any other component would.
-        tg = _ground_travel(k, medium, b.kappa2, z, mono)
+        tg = (0.5 * lateral_travel(k, medium, b.kappa2 / 4, z, below_surface=True) if mono
+              else lateral_travel(k, medium, b.kappa2, z, below_surface=True))
         ge = _taper(ap * tg, ap * tg, reach[0], Mx * dx - reach[0]) \
             * _taper(aq * tg, aq * tg, reach[1], My * dy - reach[1])
     w_ev = np.where(np.isfinite(tg), ge, 1.0)      # 1: evanescent all the way down
     mask = np.where(b.evanescent, w_ev, wx * wy).ravel()[b.unfold].reshape(grid)
     mask.setflags(write=False)
     return mask
-
-
-def _ground_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float,
-                   mono: bool) -> np.ndarray:
-    """:func:`lateral_travel` below the surface only (``inf`` where a component is
-    evanescent in a layer it crosses); a transceiver's components travel both ways."""
-    k2 = kappa2 / 4 if mono else kappa2
-    travel = np.zeros(np.shape(kappa2))
-    for m, h in medium.crossings(z):
-        if m == 0:
-            continue
-        kz = medium.kz(k, k2, m).real
-        travel = travel + np.where(kz > 0, h / np.where(kz > 0, kz, 1), np.inf)
-    return 0.5 * travel if mono else travel
 
 
 def _taper(low: np.ndarray, high: np.ndarray, needed: float, limit: float) -> np.ndarray:

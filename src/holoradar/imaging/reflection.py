@@ -149,7 +149,7 @@ def _find_spot(h: Hologram, op: AngularSpectrum, E: np.ndarray, guess: np.ndarra
     return float(gx[ix]), float(gy[iy]), float(a[iy, ix])
 
 
-def _check(hologram: Hologram, medium: Medium, source: object, method: str) -> float:
+def _check(hologram: Hologram, medium: Medium, source: object, method: str) -> None:
     if not isinstance(hologram, Hologram):
         raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
     if not isinstance(medium, Medium) or medium.is_free_space:
@@ -163,12 +163,9 @@ def _check(hologram: Hologram, medium: Medium, source: object, method: str) -> f
                          "image focuses); for a plane wave the glare is a plane wave: use "
                          "method='background'")
     z0 = medium.z_interfaces[0]
-    if method == "background":
-        return np.nan
-    zs = float(source.position[2])
-    if zs >= z0:
-        raise ValueError(f"source range {zs} m must lie above the ground surface ({z0} m)")
-    return 2 * z0 - zs
+    if method != "background" and float(source.position[2]) >= z0:
+        raise ValueError(f"source range {float(source.position[2])} m must lie above the "
+                         f"ground surface ({z0} m)")
 
 
 def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
@@ -259,13 +256,14 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         if not isinstance(initial, dict) or not need <= set(initial):
             raise ValueError(f"initial must be the parameters dict of a previous {method!r} "
                              f"report (keys {sorted(need)}), got {initial!r}")
-    z_m = _check(hologram, medium, src, method)
+    _check(hologram, medium, src, method)
     data = hologram.data
     pose = hologram.pose
     if method != "background":
         # Everything below happens in the aperture's own frame (x, y along its
         # axes, z' along its normal): the mirror image's spherical wave focuses, in
-        # free space, at its own coordinates there, for any tilt.
+        # free space, at its own coordinates there, for any tilt (frontal: the
+        # mirror plane z_m = 2 z0 - z_s).
         mirror_local = pose.to_local(src.mirror_position(medium))
         z_m = float(mirror_local[2])
         if z_m <= 0:

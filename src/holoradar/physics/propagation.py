@@ -128,16 +128,20 @@ def spectral_quadrant(shape: tuple[int, int], dx: float, dy: float
 _FREE = Medium.free_space()
 
 
-def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float) -> np.ndarray:
+def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float, *,
+                   below_surface: bool = False) -> np.ndarray:
     """Lateral distance per unit transverse wavenumber, ``sum_j h_j / Re(kz_j)`` (m^2/rad).
 
     A component (p, q) travelling from range ``z`` to the aperture shifts laterally
     by ``p * travel`` along x and ``q * travel`` along y (the group delay of its
     phase, ``d(phase)/dp``). Evanescent components get ``inf``.
+    ``below_surface=True`` sums the ground's layers only (the air path left out).
     """
     kappa2 = np.asarray(kappa2, dtype=float)
     travel = np.zeros(np.shape(kappa2))
     for m, h in medium.crossings(z):
+        if below_surface and m == 0:
+            continue
         kz = medium.kz(k, kappa2, m).real
         travel = travel + np.where(kz > 0, h / np.where(kz > 0, kz, 1), np.inf)
     return travel
