@@ -133,8 +133,12 @@ def test_unreadable_files_get_one_clear_error(tmp_path):
         hr.load(tmp_path / "nowhere.nc")
     foreign = tmp_path / "foreign.nc"
     to_dataset(HOLOGRAMS["single"]).drop_attrs().to_netcdf(foreign, engine="h5netcdf")
-    with pytest.raises(ValueError, match=r"not a holoradar file.*hologram"):
+    # A NetCDF file from another program is read like any user's file: the message
+    # names the variable and how to declare its I/Q axis, and the declared layout works.
+    with pytest.raises(ValueError, match=r"foreign\.nc: 'hologram' is real.*axes=yxc"):
         hr.load(foreign)
+    back = hr.load(foreign, layout="data=hologram, axes=yxc")
+    assert np.array_equal(back.data, HOLOGRAMS["single"].data)
     data = good.read_bytes()
     cut = tmp_path / "cut.nc"
     cut.write_bytes(data[: len(data) // 2])

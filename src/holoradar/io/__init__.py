@@ -4,21 +4,29 @@
 :class:`~holoradar.Image` to ``path`` (``.nc``), refusing to overwrite an
 existing file unless ``overwrite=True``, checking the folder first and writing
 atomically (a temporary file beside it, renamed) with the user's umask.
-``load(path)`` gives the object back, equal to what was saved. The layout is
-described in :mod:`holoradar.io.netcdf`.
+``load(path)`` gives the object back, equal to what was saved (the file layout
+is described in :mod:`holoradar.io.netcdf`), and reads a user's own files
+(NumPy, MATLAB, HDF5, CSV, foreign NetCDF) given a :class:`Layout`.
 """
 
 from __future__ import annotations
 
+import json
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..data.hologram import Hologram, Image
+from ..data.plausibility import check_plausible
+from .layout import Layout, assemble
 from .netcdf import from_dataset, read_history, to_dataset
 from .output import check_output, write_via_temp
+from .readers import read_variables
 
-__all__ = ["load", "read_history", "save"]
+__all__ = ["Layout", "load", "read_history", "read_sidecar", "read_variables", "save"]
 
 NETCDF_SUFFIXES = (".nc", ".nc4")
 
@@ -69,14 +77,32 @@ def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool
     return write_via_temp(target, write)
 
 
-def load(path: str | os.PathLike[str]) -> Hologram | Image:
-    """Read a Hologram or Image saved by :func:`save`.
+def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | str | None = None,
+         check: bool = True) -> Hologram | Image:
+    """Read a hologram or image: a holoradar NetCDF file, or a user's file of arrays.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.nc`` written by :func:`save` (an equal object comes back), or a
+        user's file: ``.npz``, ``.npy``, ``.mat`` (v5 and v7.3), ``.h5``/``.hdf5``,
+        ``.csv`` or a foreign ``.nc``; see :mod:`holoradar.io.readers`.
+    layout : Layout, dict or str, optional
+        For a user's file: which variable is the field, the axes, the units
+        (:class:`~holoradar.io.layout.Layout`; a string is its ``key=value,...``
+        form). A JSON sidecar (same name, ``.json``) may hold a ``"layout"`` and
+        the coordinates; these arguments override it.
+    check : bool
+        Refuse a hologram whose numbers look like a unit mistake (pitch against
+        wavelength, a frequency in GHz, all zeros): see
+        :func:`~holoradar.data.plausibility.check_plausible`.
 
     Raises
     ------
     ValueError
-        The file is missing, empty, truncated, not NetCDF-4/HDF5, or not a holoradar
-        file (the message lists what it holds).
+        The file is missing, empty, truncated or damaged, holds a pickled object
+        array, lacks a variable (the message lists what it holds and what is
+        needed), or looks like a unit mistake.
 
     Examples
     --------
@@ -87,10 +113,85 @@ def load(path: str | os.PathLike[str]) -> Hologram | Image:
     >>> p = save(img, pathlib.Path(tempfile.mkdtemp()) / "i.nc")
     >>> load(p).data.shape
     (2, 3)
+
+    A user's file, coordinates in millimetres and the frequency in GHz:
+
+    >>> q = pathlib.Path(tempfile.mkdtemp()) / "scan.npz"
+    >>> x = np.arange(16) * 25.0
+    >>> np.savez(q, I=np.ones((16, 16)), Q=np.zeros((16, 16)), x=x, y=x, f=9.9)
+    >>> h = load(q, layout="units=mm, frequency_unit=GHz")
+    >>> h.pitch, h.frequency
+    ((0.025, 0.025), 9900000000.0)
     """
+    src = Path(path)
+    lay = _as_layout(layout)
+    if src.suffix.lower() in NETCDF_SUFFIXES and lay is None and _is_holoradar_netcdf(src):
+        obj = _load_netcdf(src)
+    else:
+        variables = read_variables(src)
+        sidecar = src.with_suffix(".json")
+        side_layout = None
+        if sidecar.is_file():
+            extra, side_layout = read_sidecar(sidecar)
+            variables = {**extra, **variables}  # the file's own arrays win
+        full = (side_layout or Layout()).merged(lay)
+        obj = assemble(variables, full, what=src.name)
+    if check and isinstance(obj, Hologram):
+        check_plausible(obj, what=src.name)
+    return obj
+
+
+def _as_layout(layout: Any) -> Layout | None:
+    if layout is None or isinstance(layout, Layout):
+        return layout
+    if isinstance(layout, str):
+        return Layout.parse(layout)
+    if isinstance(layout, Mapping):
+        return Layout.from_mapping(layout)
+    raise ValueError(f"layout must be a holoradar.io.Layout, a dict or 'key=value,...' text, "
+                     f"got {type(layout).__name__}")
+
+
+def _is_holoradar_netcdf(src: Path) -> bool:
+    import h5py
+
+    try:
+        with h5py.File(src, "r") as f:
+            return "holoradar_kind" in f.attrs
+    except Exception:  # not HDF5 at all: let the NetCDF reader name the problem
+        return True
+
+
+def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:
+    """A JSON sidecar: its numeric entries (numbers or lists of numbers) as variables,
+    and its ``"layout"`` object as a :class:`Layout`."""
+    if path.stat().st_size > 64 * 2**20:
+        raise ValueError(f"sidecar {path.name} is larger than 64 MiB")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ValueError(f"sidecar {path.name} is not valid JSON ({exc})") from None
+    if not isinstance(doc, dict):
+        raise ValueError(f"sidecar {path.name} must hold a JSON object, got "
+                         f"{type(doc).__name__}")
+    extra: dict[str, np.ndarray] = {}
+    for key, value in doc.items():
+        if key == "layout" or isinstance(value, bool):
+            continue
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError, OverflowError):
+            continue
+        if arr.ndim <= 2:
+            extra[key] = arr
+    lay = doc.get("layout")
+    return extra, (None if lay is None else Layout.from_mapping(lay, f"sidecar {path.name} "
+                                                                     "layout"))
+
+
+def _load_netcdf(src: Path) -> Hologram | Image:
     import xarray as xr
 
-    src = Path(path)
     if not src.is_file():
         raise ValueError(f"path {str(src)!r} is not a file")
     if src.stat().st_size == 0:

@@ -131,6 +131,17 @@ def _check_eps(eps: complex, name: str) -> complex:
                          f"Im(eps) < 0 would be a medium with gain, got {e}")
     if e == 0:
         raise ValueError(f"{name} must be non-zero")
+    # No ground is optically thinner than air, and a negative real part is a metal or
+    # plasma, not soil: both are far likelier slips (a sign, a loss tangent or
+    # conductivity typed in the permittivity's place) than the intended medium.
+    if e.real < 0:
+        raise ValueError(f"{name} = {e} has a negative real part: a sign slip? holoradar's "
+                         "permittivities are eps' + i*eps'' with eps' >= 1 and loss as a "
+                         "positive imaginary part (e.g. sand 2.5+0.0125j)")
+    if e.real < 1:
+        raise ValueError(f"{name} = {e} has a real part below 1 (air): no soil, rock or "
+                         "concrete has one; was a loss tangent or a conductivity given in "
+                         "the permittivity's place? (e.g. sand 2.5+0.0125j)")
     return e
 
 
