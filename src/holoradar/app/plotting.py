@@ -18,7 +18,8 @@ from matplotlib.patches import Rectangle
 from ..analysis.theory import SpectralWindow
 from ..data.hologram import Hologram, Image
 
-__all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_spectrum", "to_png"]
+__all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_planes", "plot_section",
+           "plot_spectrum", "to_png"]
 
 CM = 100.0
 
@@ -230,4 +231,82 @@ def plot_oblique_plan(plan: Any, aperture: Any, source: Any, medium: Any,
                  f"{plan.glare_fraction:.2%}")
     ax.set_aspect("equal")
     ax.legend(loc="lower left", fontsize=7)
+    return fig
+
+
+def _scaled(a: np.ndarray, ref: float, db_range: float | None) -> tuple[np.ndarray, float,
+                                                                       float, str]:
+    if db_range is None:
+        return a / ref, 0.0, 1.0, "|E| / max"
+    return (20 * np.log10(np.maximum(a / ref, 10 ** (-db_range / 20))), -db_range, 0.0,
+            "|E| (dB re max)")
+
+
+def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = None,
+                shared: bool = True, z_surface: float | None = None,
+                title: str = "") -> Figure:
+    """|image| in the planes nearest ``zs``, one panel each.
+
+    ``shared`` puts every panel on one colour scale (the maximum over the
+    panels), so their brightness compares; otherwise each is normalised to its
+    own maximum. ``db_range`` draws ``20 log10 |E|`` over that many dB.
+    ``z_surface`` labels each plane with its depth below the ground surface
+    ``z - z_surface`` as well as its range.
+    """
+    idx = [int(np.argmin(np.abs(img.z - z))) for z in zs]
+    vol = np.abs(img.data).reshape((-1, img.z.size, img.y.size, img.x.size))[0] \
+        if img.has_z_axis else np.abs(img.data).reshape((-1, 1, img.y.size, img.x.size))[0]
+    panels = [vol[i] for i in idx]
+    gmax = max(float(p.max()) for p in panels) or 1.0
+    fig = Figure(figsize=(max(6.0, 4.6 * len(panels)), 4.8), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(panels)))
+    for ax, p, i in zip(axes, panels, idx, strict=True):
+        ref = gmax if shared else (float(p.max()) or 1.0)
+        a, vmin, vmax, label = _scaled(p, ref, db_range)
+        m = ax.pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, a, cmap="inferno",
+                          vmin=vmin, vmax=vmax, shading="flat")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (cm)")
+        ax.set_ylabel("y (cm)")
+        z = float(img.z[i])
+        depth = "" if z_surface is None else f", depth {(z - z_surface) * CM:.1f} cm below " \
+                                               "the surface"
+        ax.set_title(f"range z = {z * CM:.1f} cm{depth}", fontsize=9)
+        if not shared or ax is axes[-1]:
+            fig.colorbar(m, ax=ax, label=label + (" (all panels)" if shared else ""))
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot_section(img: Image, *, along: str = "x", at: float = 0.0,
+                 db_range: float | None = None, z_surface: float | None = None,
+                 title: str = "") -> Figure:
+    """A vertical section of |image| (x-z at ``y = at``, or y-z at ``x = at``); the
+    vertical axis is the range, with the depth below the surface on the right."""
+    vol = np.abs(img.data).reshape((-1, img.z.size, img.y.size, img.x.size))[0]
+    if along == "x":
+        j = int(np.argmin(np.abs(img.y - at)))
+        sec, h, where = vol[:, j, :], img.x, f"y = {img.y[j] * CM:.1f} cm"
+    else:
+        j = int(np.argmin(np.abs(img.x - at)))
+        sec, h, where = vol[:, :, j], img.y, f"x = {img.x[j] * CM:.1f} cm"
+    a, vmin, vmax, label = _scaled(sec, float(sec.max()) or 1.0, db_range)
+    fig = Figure(figsize=(8.0, 5.0), layout="constrained")
+    ax = fig.subplots()
+    m = ax.pcolormesh(_edges(h) * CM, _edges(img.z) * CM, a, cmap="inferno", vmin=vmin,
+                      vmax=vmax, shading="flat")
+    ax.invert_yaxis()
+    ax.set_xlabel(f"{along} (cm)")
+    ax.set_ylabel("range z from the array (cm)")
+    if z_surface is not None:
+        ax.axhline(z_surface * CM, color="c", lw=1, ls="--", label="ground surface")
+        ax.legend(loc="lower right", fontsize=8)
+        sec_ax = ax.secondary_yaxis("right", functions=(lambda v: v - z_surface * CM,
+                                                        lambda v: v + z_surface * CM))
+        sec_ax.set_ylabel("depth below the surface (cm)")
+    ax.set_title(f"|image| in the section {where}")
+    fig.colorbar(m, ax=ax, label=label)
+    if title:
+        fig.suptitle(title)
     return fig

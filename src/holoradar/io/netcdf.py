@@ -127,7 +127,10 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     """
     import xarray as xr
 
-    steps = list(history or [])
+    now = datetime.now(UTC).isoformat(timespec="seconds")
+    steps = [{**step, "holoradar": step.get("holoradar", _version()),
+              "time": step.get("time", now)} if isinstance(step, dict) else step
+             for step in (history or [])]
     attrs: dict[str, Any] = {"Conventions": "CF-1.8", "holoradar_conventions": CONVENTIONS,
                              "holoradar_version": _version(),
                              "iq_convention": "sample = I + iQ (iq index 0, 1); time "
@@ -164,7 +167,7 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     data = np.asarray(obj.data)
     lead = [f"frame{i}" for i in range(data.ndim - len(core))]
     steps.append({"step": "save", "parameters": {"kind": kind}, "holoradar": _version(),
-                  "time": datetime.now(UTC).isoformat(timespec="seconds")})
+                  "time": now})
     attrs["holoradar_kind"] = kind
     attrs["history"] = json.dumps(steps)
     values = xr.Variable((*lead, *core, "iq"), _split_iq(data),

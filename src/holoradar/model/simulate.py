@@ -23,6 +23,7 @@ Against a direct Rayleigh-Sommerfeld sum the field agrees to about 0.1%.
 from __future__ import annotations
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .._validate import as_real, check_frequency
 from ..data.hologram import C0, Hologram, _frequency_axis
@@ -40,7 +41,8 @@ _MARGIN_WAVELENGTHS = 10.0
 def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | np.ndarray, *,
              include_targets: bool = True, include_surface: bool = True,
              include_direct: bool = False, snr_db: float | None = None,
-             seed: int | None = None, monostatic: bool | None = None) -> Hologram | np.ndarray:
+             seed: int | None = None, monostatic: bool | None = None,
+             progress: bool = False) -> Hologram | np.ndarray:
     """Simulate the hologram of ``scene`` recorded by ``aperture`` at ``frequency``.
 
     Parameters
@@ -72,6 +74,9 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         ``a * G(element, target)^2`` (``G`` the exact layered Green's function,
         symmetric by reciprocity); the scene's source is not used. Default: the
         aperture's own ``monostatic`` (False for bare positions).
+    progress : bool, optional
+        Show a progress bar over the frequencies once the work has taken a second
+        (default False).
 
     Returns
     -------
@@ -123,7 +128,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
                          "targets, e.g. a grid of them over the object")
     rng = np.random.default_rng(seed)
     rows = []
-    for f in freqs:
+    for f in tqdm(freqs, desc="simulate", unit="frequency", disable=not progress, delay=1.0):
         k = 2 * np.pi * f / C0
         if mono:
             total = _monostatic(k, medium, scene, pts, include_targets, include_surface)

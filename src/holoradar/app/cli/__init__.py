@@ -1,0 +1,83 @@
+"""The ``holoradar`` command line.
+
+Every command takes ``--help``, ``--json`` (a machine-readable summary on
+stdout) and ``--quiet``. A user's mistake (a bad argument, an unreadable or
+implausible file, an output that would destroy data) is one line on stderr,
+``error: ...``, and exit code 2; warnings are one line each. Outputs are
+checked before any work, never replace an input or an existing file unless
+``--force`` is given, and are written atomically with the user's umask.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from typing import Any
+
+import click
+
+__all__ = ["main"]
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _show_warning(message: Any, category: type[Warning], filename: str, lineno: int,
+                  file: Any = None, line: Any = None) -> None:
+    click.echo(f"warning: {_one_line(str(message))} ({category.__name__})", err=True)
+
+
+class HoloradarGroup(click.Group):
+    """A click group whose user errors are one line and exit code 2, never a traceback."""
+
+    def main(self, args: Any = None, prog_name: str | None = None,  # type: ignore[override]
+             complete_var: str | None = None, standalone_mode: bool = True,
+             **extra: Any) -> Any:
+        old = warnings.showwarning
+        warnings.showwarning = _show_warning
+        try:
+            return super().main(args, prog_name, complete_var, standalone_mode=False, **extra)
+        except click.exceptions.NoArgsIsHelpError as exc:  # bare "holoradar"
+            click.echo(exc.ctx.get_help() if exc.ctx else str(exc))
+            sys.exit(0)
+        except click.ClickException as exc:
+            hint = f" (see {exc.ctx.command_path} --help)" if getattr(exc, "ctx", None) \
+                else ""
+            click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
+            sys.exit(2 if exc.exit_code in (1, 2) else exc.exit_code)
+        except click.exceptions.Exit as exc:
+            sys.exit(exc.exit_code)
+        except click.Abort:
+            click.echo("error: aborted", err=True)
+            sys.exit(1)
+        except (ValueError, KeyError) as exc:
+            click.echo(f"error: {_one_line(str(exc))}", err=True)
+            sys.exit(2)
+        except OSError as exc:
+            click.echo(f"error: {_one_line(str(exc))}", err=True)
+            sys.exit(1)
+        finally:
+            warnings.showwarning = old
+
+
+@click.group(cls=HoloradarGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="holoradar")
+def main() -> None:
+    """holoradar: holographic subsurface radar imaging and simulation.
+
+    Typical use: `holoradar info FILE` to see what a file holds, `holoradar
+    image FILE --z 0.3:0.6:0.005 --eps 2.5 --z-surface 0.3 --out img.nc` to
+    image it, `holoradar plot img.nc --out img.png` to look at it.
+    """
+
+
+def _register() -> None:
+    from . import batch, calibrate, image, info, misc, plot, process, simulate
+
+    for module in (misc, simulate, image, process, calibrate, info, plot, batch):
+        for cmd in module.COMMANDS:
+            main.add_command(cmd)
+
+
+_register()

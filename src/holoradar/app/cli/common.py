@@ -1,0 +1,226 @@
+"""What every command shares: --json/--quiet reporting, reading a hologram with a layout,
+the ground from flags or a TOML file, depth ranges, safe outputs."""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+__all__ = ["Reporter", "depth_ranges", "input_history", "layout_option", "medium_from_options",
+           "medium_options",
+           "output_options", "read_hologram"]
+
+
+class Reporter:
+    """Human lines unless ``--quiet``; with ``--json`` only the JSON summary on stdout."""
+
+    def __init__(self, as_json: bool, quiet: bool) -> None:
+        self.as_json, self.quiet = as_json, quiet
+
+    @property
+    def progress(self) -> bool:
+        """Whether progress bars are shown (on stderr)."""
+        return not self.quiet
+
+    def line(self, text: str) -> None:
+        if not (self.quiet or self.as_json):
+            click.echo(text)
+
+    def done(self, summary: dict[str, Any], lines: Sequence[str] = ()) -> None:
+        if self.as_json:
+            click.echo(json.dumps(_plain(summary), indent=2))
+        elif not self.quiet:
+            for text in lines:
+                click.echo(text)
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, dict):
+        return {str(k): _plain(e) for k, e in v.items()}
+    if isinstance(v, list | tuple):
+        return [_plain(e) for e in v]
+    if isinstance(v, np.ndarray):
+        return _plain(v.tolist())
+    if isinstance(v, complex | np.complexfloating):
+        return {"re": float(v.real), "im": float(v.imag)}
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, Path):
+        return str(v)
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def output_options(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``--json`` and ``--quiet``; the command receives ``report: Reporter``."""
+
+    @click.option("--json", "as_json", is_flag=True,
+                  help="Print a machine-readable JSON summary on stdout (and nothing else).")
+    @click.option("--quiet", "-q", is_flag=True,
+                  help="Print nothing but errors and warnings; no progress bars.")
+    @functools.wraps(fn)
+    def wrapper(*args: Any, as_json: bool, quiet: bool, **kwargs: Any) -> Any:
+        return fn(*args, report=Reporter(as_json, quiet), **kwargs)
+
+    return wrapper
+
+
+def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``--layout`` and ``--no-check`` for reading users' files."""
+
+    @click.option("--layout", default=None, metavar="KEY=VALUE,...",
+                  help="Where the hologram is in a user's file and in what units, e.g. "
+                       "'data=E[1],units=mm,frequency=9.9,frequency_unit=GHz' or "
+                       "'i=I,q=Q,axes=fyx' (keys: data, i, q, amplitude, phase, x, y, "
+                       "frequency, pitch, axes, units, frequency_unit, phase_unit, iq_sign, "
+                       "monostatic). A JSON sidecar FILE.json may hold it as \"layout\".")
+    @click.option("--no-check", is_flag=True,
+                  help="Skip the plausibility checks of units (pitch against wavelength, "
+                       "frequency in Hz, all-zero data).")
+    @functools.wraps(fn)
+    def wrapper(*args: Any, layout: str | None, no_check: bool, **kwargs: Any) -> Any:
+        return fn(*args, layout=layout, check=not no_check, **kwargs)
+
+    return wrapper
+
+
+def read_hologram(path: Path, layout: str | None, check: bool) -> Any:
+    """A hologram from any supported file; an image file is refused by name."""
+    from ...data.hologram import Hologram
+    from ...io import load
+
+    obj = load(path, layout=layout, check=check)
+    if not isinstance(obj, Hologram):
+        raise ValueError(f"{path.name} holds an image, not a hologram")
+    return obj
+
+
+def input_history(path: Path, layout: str | None) -> list[dict[str, Any]]:
+    """The steps that made an input: its stored history (a holoradar file), else its import."""
+    from ...io import read_history
+
+    if path.suffix.lower() in (".nc", ".nc4") and layout is None:
+        try:
+            return [s for s in read_history(path) if isinstance(s, dict)]
+        except (ValueError, OSError):
+            pass
+    return [{"step": "import", "input": path.name, "parameters": {"layout": layout}}]
+
+
+def medium_options(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """The ground: a half-space from flags, layers from flags, or a TOML file."""
+
+    @click.option("--eps", default=None, metavar="EPS",
+                  help="Ground permittivity eps' or eps'+eps''j (loss positive), e.g. 2.5 or "
+                       "2.5+0.0125j.")
+    @click.option("--z-surface", type=float, default=None,
+                  help="Range of the ground surface from the array plane, m.")
+    @click.option("--tan-delta", type=click.FloatRange(min=0), default=None,
+                  help="Loss tangent: eps = eps' (1 + i tan_delta).")
+    @click.option("--sigma", type=click.FloatRange(min=0), default=None,
+                  help="Conductivity, S/m: adds i sigma / (omega eps0) at the (centre) "
+                       "frequency.")
+    @click.option("--layers", default=None, metavar="TOP:EPS,...",
+                  help="Layered ground, top-down: each layer's top range (m) and "
+                       "permittivity, e.g. '0.30:5+0.1j,0.315:8+0.2j,0.335:12+0.5j'.")
+    @click.option("--medium", "medium_file", default=None,
+                  type=click.Path(exists=True, dir_okay=False, path_type=Path),
+                  help="The ground from a TOML file: surface, eps[, tan_delta, sigma], or "
+                       "[[layer]] tables with top, eps.")
+    @functools.wraps(fn)
+    def wrapper(*args: Any, eps: str | None, z_surface: float | None, tan_delta: float | None,
+                sigma: float | None, layers: str | None, medium_file: Path | None,
+                **kwargs: Any) -> Any:
+        spec = {"eps": eps, "z_surface": z_surface, "tan_delta": tan_delta, "sigma": sigma,
+                "layers": layers, "medium_file": medium_file}
+        return fn(*args, medium_spec=spec, **kwargs)
+
+    return wrapper
+
+
+def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
+    """The Medium the flags describe (None: free space)."""
+    import tomllib
+
+    from ...model.scene_file import medium_from_mapping, parse_complex
+
+    eps, zs, td, sg = spec["eps"], spec["z_surface"], spec["tan_delta"], spec["sigma"]
+    layers, mfile = spec["layers"], spec["medium_file"]
+    given = [n for n, v in (("--eps", eps), ("--z-surface", zs), ("--layers", layers),
+                            ("--medium", mfile)) if v is not None]
+    if mfile is not None:
+        if len(given) > 1 or td is not None or sg is not None:
+            raise click.BadParameter("--medium describes the whole ground: give no other "
+                                     "ground flag", param_hint="--medium")
+        try:
+            doc = tomllib.loads(mfile.read_text(encoding="utf-8"))
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{mfile.name} is not valid TOML ({exc})") from None
+        table = doc.get("ground", doc)
+        return medium_from_mapping(table, frequency, where=mfile.stem)
+    loss = {k: v for k, v in (("tan_delta", td), ("sigma", sg)) if v is not None}
+    if layers is not None:
+        if eps is not None or zs is not None:
+            raise click.BadParameter("give --layers or --eps with --z-surface, not both",
+                                     param_hint="--layers")
+        items = []
+        for part in layers.split(","):
+            top, sep, value = part.partition(":")
+            try:
+                top_m = float(top)
+            except ValueError:
+                top_m = math.nan
+            if not sep or not math.isfinite(top_m):
+                raise click.BadParameter(f"each layer is TOP:EPS (m, permittivity), got "
+                                         f"{part!r}", param_hint="--layers")
+            items.append({"top": top_m, "eps": parse_complex(value, "--layers eps"), **loss})
+        return medium_from_mapping({"layer": items}, frequency, where="--layers")
+    if eps is None and zs is None:
+        if loss:
+            raise click.BadParameter("--tan-delta/--sigma need a ground: --eps and --z-surface",
+                                     param_hint="--tan-delta/--sigma")
+        return None
+    if eps is None or zs is None:
+        raise click.BadParameter("give both --eps and --z-surface, or neither",
+                                 param_hint="--eps/--z-surface")
+    return medium_from_mapping({"surface": zs, "eps": parse_complex(eps, "--eps"), **loss},
+                               frequency, where="ground")
+
+
+def depth_ranges(text: str, name: str = "--z") -> float | np.ndarray:
+    """``0.4`` or ``start:stop:step`` (metres, step > 0, stop >= start)."""
+    try:
+        if ":" not in text:
+            v = float(text)
+            if not math.isfinite(v):
+                raise ValueError
+            return v
+        a, b, st = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise click.BadParameter(f"expected a range in metres or start:stop:step, got {text!r}",
+                                 param_hint=name) from None
+    if not (np.isfinite([a, b, st]).all() and st > 0 and b >= a):
+        raise click.BadParameter(f"start:stop:step needs step > 0 and stop >= start, got "
+                                 f"{text!r}", param_hint=name)
+    if (b - a) / st > 100000:
+        raise click.BadParameter(f"{text!r} asks for more than 100000 planes", param_hint=name)
+    return np.arange(a, b + st / 2, st)
+
+
+def triple(text: str, name: str) -> tuple[float, float, float]:
+    """``x,y,z`` in metres."""
+    try:
+        v = tuple(float(t) for t in text.split(","))
+    except ValueError:
+        v = ()
+    if len(v) != 3 or not all(math.isfinite(e) for e in v):
+        raise click.BadParameter(f"expected x,y,z in metres, got {text!r}", param_hint=name)
+    return v  # type: ignore[return-value]

@@ -1,0 +1,113 @@
+"""``holoradar image``: migrate a hologram to one range or a depth sweep."""
+
+from __future__ import annotations
+
+import io
+import time
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import (
+    Reporter,
+    depth_ranges,
+    input_history,
+    layout_option,
+    medium_from_options,
+    medium_options,
+    output_options,
+    read_hologram,
+)
+
+__all__ = ["COMMANDS", "write_image"]
+
+
+def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
+                png: bool, title: str) -> list[str]:
+    """Write an image as .nc (with its history) or .npz, and a PNG of its brightest plane."""
+    from ...analysis.metrics import peak_position
+    from ...io import save
+    from .. import plotting
+    from ..atomic import write_atomic
+
+    if out.suffix.lower() in (".nc", ".nc4"):
+        save(img, out, overwrite=force, history=history)
+    else:
+        buf = io.BytesIO()
+        np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency)
+        write_atomic(out, buf.getvalue())
+    files = [str(out)]
+    if png:
+        pk = peak_position(img)
+        fig = plotting.plot_image([img.plane(pk[2])], [title])
+        write_atomic(out.with_suffix(".png"), plotting.to_png(fig))
+        files.append(str(out.with_suffix(".png")))
+    return files
+
+
+@click.command()
+@click.argument("hologram_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--z", "z", required=True,
+              help="Range(s) from the array plane in metres: 0.4, or a sweep start:stop:step "
+                   "such as 0.3:0.5:0.005.")
+@medium_options
+@click.option("--method", type=click.Choice(["angular", "fresnel"]), default="angular",
+              show_default=True, help="Exact angular spectrum, or the paper's Fresnel kernel.")
+@click.option("--frame", type=click.Choice(["aperture", "ground"]), default="aperture",
+              show_default=True,
+              help="Planes parallel to the array (aperture) or level planes in the ground's "
+                   "frame (for a tilted array; --z is then the world range).")
+@click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32),
+              help="Image pixels per element pitch.")
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="Output image: .nc (NetCDF-4, holoradar.load reads it) or .npz.")
+@click.option("--png/--no-png", default=True, show_default=True,
+              help="Also write a PNG of the brightest plane beside --out.")
+@click.option("--force", is_flag=True, help="Replace existing output files.")
+@layout_option
+@output_options
+def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str, frame: str,
+          upsample: int, out: Path, png: bool, force: bool, layout: str | None, check: bool,
+          report: Reporter) -> None:
+    """Migrate a hologram to range(s) Z through air or a (layered, lossy) ground.
+
+    HOLOGRAM_FILE: a holoradar .nc file, or a user's .npz, .npy (+ .json
+    sidecar), .mat, .h5 or .csv with --layout saying where the field is.
+    """
+    from ...analysis.metrics import peak_position
+    from ...imaging.migrate import migrate
+    from ...io.output import check_output
+
+    zs = depth_ranges(z)
+    # Outputs are checked before any work: never an input, never replaced unasked.
+    check_output(out, suffixes=[".nc", ".nc4", ".npz"], inputs=[hologram_file],
+                 overwrite=force, name="--out")
+    if png:
+        check_output(out.with_suffix(".png"), suffixes=[".png"], inputs=[hologram_file],
+                     overwrite=force, name="--out's PNG")
+    holo = read_hologram(hologram_file, layout, check)
+    medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
+    t0 = time.perf_counter()
+    img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
+                  progress=None if report.progress else False)
+    seconds = time.perf_counter() - t0
+    pk = peak_position(img)
+    ground = None if medium is None else {"z_interfaces": list(medium.z_interfaces),
+                                           "eps": [str(e) for e in medium.eps]}
+    history = [*input_history(hologram_file, layout), {
+        "step": "migrate", "input": hologram_file.name,
+        "parameters": {"z": z, "method": method, "frame": frame, "upsample": upsample,
+                       "layout": layout, "medium": ground}}]
+    files = write_image(img, out, force, history, png, f"{hologram_file.name} ({method})")
+    report.done({"peak_m": pk, "out": str(out), "files": files, "planes": int(img.z.size),
+                 "shape": list(img.data.shape), "seconds": seconds}, [
+        f"imaged {hologram_file.name}: {img.z.size} plane(s), {img.x.size} x {img.y.size} "
+        f"pixels, in {seconds:.1f} s",
+        f"brightest point x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
+        *[f"wrote {f}" for f in files],
+    ])
+
+
+COMMANDS = [image]

@@ -1,0 +1,114 @@
+"""``holoradar info FILE``: a table of what a file holds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import Reporter, output_options
+
+__all__ = ["COMMANDS", "describe"]
+
+
+def _span(v: np.ndarray) -> str:
+    v = np.asarray(v, float)
+    if v.size == 1:
+        return f"{v[0]:.6g}"
+    return f"{v[0]:.6g} .. {v[-1]:.6g} ({v.size}, step {(v[-1] - v[0]) / (v.size - 1):.6g})"
+
+
+def describe(obj: Any) -> dict[str, Any]:
+    """The facts ``info`` prints about a Hologram or Image."""
+    from ...data.hologram import Hologram
+    from ...data.plausibility import plausibility_problems
+
+    f = np.atleast_1d(np.asarray(obj.frequency, float))
+    d: dict[str, Any] = {
+        "kind": type(obj).__name__,
+        "shape": list(obj.data.shape),
+        "dtype": str(obj.data.dtype),
+        "x_m": [float(obj.x[0]), float(obj.x[-1]), int(obj.x.size)],
+        "y_m": [float(obj.y[0]), float(obj.y[-1]), int(obj.y.size)],
+        "frequency_hz": f.tolist(),
+        "max_amplitude": float(np.abs(obj.data).max()),
+    }
+    if isinstance(obj, Hologram):
+        d.update(pitch_m=list(obj.pitch), monostatic=obj.monostatic,
+                 source=None if obj.source is None else repr(obj.source),
+                 pose=None if obj.pose.is_identity else {
+                     "center_m": list(obj.pose.center), "tilt_deg":
+                     float(np.degrees(obj.pose.tilt)),
+                     "azimuth_deg": float(np.degrees(obj.pose.azimuth))},
+                 problems=plausibility_problems(obj))
+    else:
+        d.update(z_m=np.asarray(obj.z, float).tolist(), method=obj.method)
+    return d
+
+
+@click.command()
+@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--layout", default=None, metavar="KEY=VALUE,...",
+              help="For a user's file: where the hologram is (see holoradar image --help).")
+@output_options
+def info(file: Path, layout: str | None, report: Reporter) -> None:
+    """Show what FILE holds: its variables, and the hologram or image read from it."""
+    from ...io import load, read_history
+    from ...io.readers import read_variables
+
+    summary: dict[str, Any] = {"file": str(file), "bytes": file.stat().st_size}
+    lines = [f"{file.name} ({file.stat().st_size} bytes)"]
+    is_ours = file.suffix.lower() in (".nc", ".nc4")
+    obj, reason = None, None
+    try:
+        obj = load(file, layout=layout, check=False)
+    except ValueError as exc:
+        if is_ours and "holoradar" not in str(exc) and layout is None:
+            raise
+        reason = str(exc)
+    if obj is None or not is_ours:
+        variables = read_variables(file)
+        summary["variables"] = {k: {"shape": list(v.shape), "dtype": str(v.dtype)}
+                                for k, v in variables.items() if not k.startswith("__")}
+        lines.append("  variables:")
+        lines += [f"    {k:24s} {tuple(v.shape)!s:18s} {v.dtype}"
+                  for k, v in variables.items() if not k.startswith("__")]
+        if "__other__" in variables:
+            lines.append(f"    (not numeric: {', '.join(map(str, variables['__other__']))})")
+    if obj is None:
+        summary["readable_as"] = None
+        summary["reason"] = reason
+        lines.append(f"  not readable as a hologram yet: {reason}")
+        report.done(summary, lines)
+        return
+    d = describe(obj)
+    summary["readable_as"] = d
+    f = np.asarray(d["frequency_hz"])
+    rows = [("kind", d["kind"]), ("shape", f"{tuple(d['shape'])} {d['dtype']}"),
+            ("x (m)", _span(obj.x)), ("y (m)", _span(obj.y)),
+            ("frequency (GHz)", _span(f / 1e9))]
+    if d["kind"] == "Hologram":
+        rows += [("pitch (mm)", f"{d['pitch_m'][0] * 1e3:.4g} x {d['pitch_m'][1] * 1e3:.4g}"),
+                 ("monostatic", str(d["monostatic"])), ("source", str(d["source"])),
+                 ("pose", str(d["pose"]))]
+    else:
+        rows += [("z (m)", _span(np.asarray(d["z_m"]))), ("method", d["method"])]
+    rows.append(("max |value|", f"{d['max_amplitude']:.4g}"))
+    lines += [f"  {k:16s} {v}" for k, v in rows]
+    for p in d.get("problems", []):
+        lines.append(f"  implausible: {p}")
+    if is_ours:
+        try:
+            hist = read_history(file)
+        except (ValueError, OSError):
+            hist = []
+        summary["history"] = hist
+        for step in hist:
+            lines.append(f"  history: {step.get('step')} {step.get('time', '')} "
+                         f"(holoradar {step.get('holoradar', '?')})")
+    report.done(summary, lines)
+
+
+COMMANDS = [info]

@@ -1,0 +1,349 @@
+"""Scenes and grounds described in TOML files, validated key by key.
+
+A scene file (all lengths in metres, frequencies in Hz, angles in degrees)::
+
+    frequency = 9.9e9                 # or a list of frequencies
+
+    [aperture]
+    n = 16                            # elements along x (ny = ... for a rectangle)
+    pitch = 0.025
+    # monostatic = true               # a scanned transceiver
+    # center = [0.0, -0.15, 0.05]     # a posed (tilted) array: world centre,
+    # tilt_deg = 35.0                 # tilt from level and
+    # azimuth_deg = 90.0              # the azimuth of the tilt axis
+
+    [ground]                          # omit for free space
+    surface = 0.30                    # range of the surface from the array plane
+    eps = 2.5                         # or "2.5+0.0125j"
+    tan_delta = 0.005                 # optional; sigma = 0.01 (S/m) also
+    # or layers, top-down, each from its top down to the next:
+    # [[ground.layer]]
+    # top = 0.30
+    # eps = 5.0
+
+    [source]                          # omit for a normal plane wave
+    type = "point"                    # "plane", "point" or "gaussian"
+    position = [0.0, -0.25, 0.0]
+    pattern_exponent = 20
+    axis = [0.0, 0.5, 1.0]            # plane: alpha_deg, beta_deg; gaussian: waist, center
+
+    [[target]]
+    type = "point"
+    position = [0.0, 0.0, 0.42]
+    amplitude = 1.0
+
+    [[target]]
+    type = "shape"                    # a planar object (Kirchhoff)
+    shape = "letter_r"                # disk, ring, rectangle, letter_r
+    z = 0.42
+    reflection = 1.0                  # -1 for metal
+    width = 0.10                      # the shape's own sizes
+    height = 0.15
+
+    [simulate]
+    include_surface = true
+    include_direct = false
+    snr_db = 40.0                     # optional receiver noise
+    seed = 1
+
+A conductivity is turned into a permittivity at the (centre) frequency:
+``eps = eps' (1 + i tan_delta) + i sigma / (omega eps0)``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..data.pose import Pose
+from ..physics.medium import Medium, permittivity
+from ..physics.sources import GaussianBeam, PlaneWave, PointSource
+from . import shapes
+from .scene import Aperture, Scene
+from .targets import PlanarTarget, PointTarget
+
+__all__ = ["SceneSpec", "load_scene", "medium_from_mapping", "parse_complex",
+           "scene_from_mapping"]
+
+_MISSING = object()
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """A scene file's content: what :func:`holoradar.simulate` needs."""
+
+    scene: Scene
+    aperture: Aperture
+    frequency: float | np.ndarray
+    options: dict[str, Any] = field(default_factory=dict)
+
+
+def parse_complex(value: Any, where: str) -> complex:
+    """A permittivity: a number or a string such as ``"2.5+0.0125j"`` (parsed, never
+    evaluated)."""
+    if isinstance(value, bool):
+        raise ValueError(f"{where} must be a number or a complex string like "
+                         f"'2.5+0.0125j', got {value!r}")
+    if isinstance(value, int | float | complex):
+        return complex(value)
+    if isinstance(value, str):
+        try:
+            return complex(value.replace(" ", "").replace("i", "j"))
+        except ValueError:
+            pass
+    raise ValueError(f"{where} must be a number or a complex string like '2.5+0.0125j', "
+                     f"got {value!r}")
+
+
+def _number(m: Mapping[str, Any], key: str, where: str, default: Any = _MISSING, *,
+            positive: bool = False, minimum: float | None = None,
+            integer: bool = False, unit: str = "") -> Any:
+    if key not in m:
+        if default is _MISSING:
+            what = "an integer" if integer else "a number"
+            raise ValueError(f"{where}: missing key {key!r} ({what}"
+                             f"{' in ' + unit if unit else ''})")
+        return default
+    v = m[key]
+    ok = isinstance(v, int) if integer else isinstance(v, int | float)
+    if isinstance(v, bool) or not ok or not math.isfinite(v):
+        raise ValueError(f"{where}.{key} must be {'an integer' if integer else 'a number'}"
+                         f"{' in ' + unit if unit else ''}, got {v!r}")
+    if positive and v <= 0:
+        raise ValueError(f"{where}.{key} must be > 0{' ' + unit if unit else ''}, got {v!r}")
+    if minimum is not None and v < minimum:
+        raise ValueError(f"{where}.{key} must be >= {minimum}, got {v!r}")
+    return v
+
+
+def _vector(m: Mapping[str, Any], key: str, where: str, n: int, default: Any = _MISSING) \
+        -> Any:
+    if key not in m:
+        if default is _MISSING:
+            raise ValueError(f"{where}: missing key {key!r} (a list of {n} numbers, metres)")
+        return default
+    v = m[key]
+    if (not isinstance(v, list) or len(v) != n
+            or not all(isinstance(e, int | float) and not isinstance(e, bool)
+                       and math.isfinite(e) for e in v)):
+        raise ValueError(f"{where}.{key} must be a list of {n} numbers, got {v!r}")
+    return tuple(float(e) for e in v)
+
+
+def _bool(m: Mapping[str, Any], key: str, where: str, default: bool) -> bool:
+    v = m.get(key, default)
+    if not isinstance(v, bool):
+        raise ValueError(f"{where}.{key} must be true or false, got {v!r}")
+    return v
+
+
+def _table(doc: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
+    v = doc.get(key, {})
+    if not isinstance(v, Mapping):
+        raise ValueError(f"{where}: [{key}] must be a table, got {type(v).__name__}")
+    return v
+
+
+def _unknown(m: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    extra = sorted(set(m) - allowed)
+    if extra:
+        raise ValueError(f"{where}: unknown key(s) {extra}; allowed: {sorted(allowed)}")
+
+
+def _eps(m: Mapping[str, Any], where: str, frequency: float) -> complex:
+    eps = parse_complex(m["eps"], f"{where}.eps") if "eps" in m else None
+    if eps is None:
+        raise ValueError(f"{where}: missing key 'eps' (relative permittivity, e.g. 2.5 or "
+                         "'2.5+0.0125j')")
+    tan_delta = _number(m, "tan_delta", where, 0.0, minimum=0.0)
+    sigma = _number(m, "sigma", where, None, minimum=0.0, unit="S/m")
+    if (tan_delta or sigma) and eps.imag:
+        raise ValueError(f"{where}: give the loss either as Im(eps) or as tan_delta/sigma, "
+                         "not both")
+    if tan_delta or sigma:
+        return permittivity(eps.real, tan_delta, sigma=sigma, frequency=frequency)
+    return eps
+
+
+def medium_from_mapping(m: Mapping[str, Any], frequency: float, where: str = "[ground]",
+                        polarization: str = "TE") -> Medium:
+    """A :class:`~holoradar.Medium` from ``{surface, eps[, tan_delta, sigma]}`` or
+    ``{layer: [{top, eps, ...}, ...]}`` (ranges in metres, top-down).
+
+    Examples
+    --------
+    >>> medium_from_mapping({"surface": 0.3, "eps": 2.5, "tan_delta": 0.005}, 9.9e9).eps
+    (1.0, (2.5+0.0125j))
+    """
+    if not isinstance(m, Mapping):
+        raise ValueError(f"{where} must be a table, got {type(m).__name__}")
+    if "layer" in m:
+        _unknown(m, {"layer", "polarization"}, where)
+        layers = m["layer"]
+        if not isinstance(layers, list) or not layers or \
+                not all(isinstance(la, Mapping) for la in layers):
+            raise ValueError(f"{where}.layer must be a list of tables [[ground.layer]] with "
+                             "top and eps")
+        tops, eps = [], []
+        for i, la in enumerate(layers):
+            w = f"{where}.layer[{i}]"
+            _unknown(la, {"top", "eps", "tan_delta", "sigma"}, w)
+            tops.append(float(_number(la, "top", w, positive=True, unit="m")))
+            eps.append(_eps(la, w, frequency))
+        return Medium.layered(tops, eps, polarization=m.get("polarization", polarization))
+    _unknown(m, {"surface", "eps", "tan_delta", "sigma", "polarization"}, where)
+    surface = float(_number(m, "surface", where, positive=True, unit="m"))
+    return Medium.half_space(surface, _eps(m, where, frequency),
+                             polarization=m.get("polarization", polarization))
+
+
+def _source(m: Mapping[str, Any], where: str) -> Any:
+    if not m:
+        return PlaneWave()
+    kind = m.get("type", "plane")
+    if kind == "plane":
+        _unknown(m, {"type", "alpha_deg", "beta_deg"}, where)
+        return PlaneWave(math.radians(_number(m, "alpha_deg", where, 0.0)),
+                         math.radians(_number(m, "beta_deg", where, 0.0)))
+    if kind == "point":
+        _unknown(m, {"type", "position", "pattern_exponent", "axis", "amplitude", "dipole"},
+                 where)
+        return PointSource(_vector(m, "position", where, 3),
+                           pattern_exponent=float(_number(m, "pattern_exponent", where, 0.0,
+                                                          minimum=0.0)),
+                           axis=_vector(m, "axis", where, 3, (0.0, 0.0, 1.0)),
+                           amplitude=parse_complex(m.get("amplitude", 1.0), f"{where}.amplitude"),
+                           dipole=_bool(m, "dipole", where, False))
+    if kind == "gaussian":
+        _unknown(m, {"type", "waist", "center", "alpha_deg", "beta_deg", "amplitude"}, where)
+        return GaussianBeam(float(_number(m, "waist", where, positive=True, unit="m")),
+                            center=_vector(m, "center", where, 3, (0.0, 0.0, 0.0)),
+                            alpha=math.radians(_number(m, "alpha_deg", where, 0.0)),
+                            beta=math.radians(_number(m, "beta_deg", where, 0.0)),
+                            amplitude=parse_complex(m.get("amplitude", 1.0),
+                                                    f"{where}.amplitude"))
+    raise ValueError(f"{where}.type must be 'plane', 'point' or 'gaussian', got {kind!r}")
+
+
+def _targets(items: Any, where: str) -> list[PointTarget | PlanarTarget]:
+    if not isinstance(items, list) or not all(isinstance(t, Mapping) for t in items):
+        raise ValueError(f"{where} must be a list of tables [[target]]")
+    out: list[PointTarget | PlanarTarget] = []
+    for i, t in enumerate(items):
+        w = f"{where}[{i}]"
+        kind = t.get("type", "point")
+        if kind == "point":
+            _unknown(t, {"type", "position", "amplitude"}, w)
+            out.append(PointTarget(_vector(t, "position", w, 3),
+                                   parse_complex(t.get("amplitude", 1.0), f"{w}.amplitude")))
+        elif kind == "shape":
+            name = t.get("shape")
+            if name not in shapes.__all__:
+                raise ValueError(f"{w}.shape must be one of {shapes.__all__}, got {name!r}")
+            sizes = {k: float(_number(t, k, w, positive=True, unit="m")) for k in t
+                     if k not in ("type", "shape", "z", "center", "reflection", "pixel")}
+            out.append(PlanarTarget.from_shape(
+                name, float(_number(t, "z", w, positive=True, unit="m")),
+                center=_vector(t, "center", w, 2, (0.0, 0.0)),
+                reflection=parse_complex(t.get("reflection", 1.0), f"{w}.reflection"),
+                pixel=float(_number(t, "pixel", w, 0.002, positive=True, unit="m")), **sizes))
+        else:
+            raise ValueError(f"{w}.type must be 'point' or 'shape', got {kind!r}")
+    return out
+
+
+def _aperture(m: Mapping[str, Any], where: str) -> Aperture:
+    _unknown(m, {"n", "ny", "pitch", "pitch_y", "monostatic", "center", "tilt_deg",
+                 "azimuth_deg"}, where)
+    n = int(_number(m, "n", where, integer=True))
+    ny = int(_number(m, "ny", where, n, integer=True))
+    for key, v in (("n", n), ("ny", ny)):
+        if not 2 <= v <= 4096:
+            raise ValueError(f"{where}.{key} must be an integer from 2 to 4096, got {v}")
+    pitch = float(_number(m, "pitch", where, positive=True, unit="m"))
+    pitch_y = float(_number(m, "pitch_y", where, pitch, positive=True, unit="m"))
+    pose = None
+    if any(k in m for k in ("center", "tilt_deg", "azimuth_deg")):
+        pose = Pose(_vector(m, "center", where, 3, (0.0, 0.0, 0.0)),
+                    tilt=math.radians(_number(m, "tilt_deg", where, 0.0)),
+                    azimuth=math.radians(_number(m, "azimuth_deg", where, 0.0)))
+    return Aperture.grid(n, pitch, ny=ny, pitch_y=pitch_y,
+                         monostatic=_bool(m, "monostatic", where, False), pose=pose)
+
+
+def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpec:
+    """A :class:`SceneSpec` from a parsed TOML document (see the module's example)."""
+    _unknown(doc, {"frequency", "aperture", "ground", "source", "target", "simulate"}, where)
+    if "frequency" not in doc:
+        raise ValueError(f"{where}: missing key 'frequency' (Hz, a number or a list)")
+    fv = doc["frequency"]
+    fl = fv if isinstance(fv, list) else [fv]
+    if not fl or not all(isinstance(f, int | float) and not isinstance(f, bool)
+                         and math.isfinite(f) and f > 0 for f in fl):
+        raise ValueError(f"{where}.frequency must be a number > 0 (Hz) or a list of them, got "
+                         f"{fv!r}")
+    if len(fl) > 1 and np.any(np.diff(fl) <= 0):
+        raise ValueError(f"{where}.frequency: a list must be strictly increasing, got {fv!r}")
+    if min(fl) < 1e8:
+        raise ValueError(f"{where}.frequency {min(fl)!r} Hz is below 100 MHz: given in GHz? "
+                         "(the scene's frequency is in Hz, e.g. 9.9e9)")
+    freq: float | np.ndarray = float(fl[0]) if not isinstance(fv, list) else np.array(fl, float)
+    fc = float(np.mean(fl))
+    if "aperture" not in doc:
+        raise ValueError(f"{where}: missing table [aperture] (n, pitch)")
+    aperture = _aperture(_table(doc, "aperture", where), f"{where}.aperture")
+    ground = _table(doc, "ground", where)
+    medium = medium_from_mapping(ground, fc, f"{where}.ground") if ground else \
+        Medium.free_space()
+    source = _source(_table(doc, "source", where), f"{where}.source")
+    targets = _targets(doc.get("target", []), f"{where}.target")
+    sim = _table(doc, "simulate", where)
+    _unknown(sim, {"include_surface", "include_direct", "include_targets", "snr_db", "seed"},
+             f"{where}.simulate")
+    options: dict[str, Any] = {
+        "include_surface": _bool(sim, "include_surface", f"{where}.simulate", True),
+        "include_direct": _bool(sim, "include_direct", f"{where}.simulate", False),
+        "include_targets": _bool(sim, "include_targets", f"{where}.simulate", True),
+        "snr_db": _number(sim, "snr_db", f"{where}.simulate", None, unit="dB"),
+        "seed": _number(sim, "seed", f"{where}.simulate", None, integer=True, minimum=0),
+    }
+    scene = Scene(medium, None if aperture.monostatic else source, targets)
+    return SceneSpec(scene, aperture, freq, options)
+
+
+def load_scene(path: str | Path) -> SceneSpec:
+    """Read and validate a TOML scene file.
+
+    Raises
+    ------
+    ValueError
+        Not TOML, or a key missing, unknown, of the wrong type or out of range:
+        the message names the key (``scene.aperture.pitch must be > 0 m``).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "s.toml"
+    >>> _ = p.write_text('frequency = 9.9e9\\n[aperture]\\nn = 16\\npitch = 0.025\\n')
+    >>> load_scene(p).aperture.x.size
+    16
+    """
+    src = Path(path)
+    if not src.is_file():
+        raise ValueError(f"scene file {str(src)!r} is not a file")
+    if src.stat().st_size > 16 * 2**20:
+        raise ValueError(f"scene file {src.name} is larger than 16 MiB")
+    try:
+        doc = tomllib.loads(src.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{src.name} is not valid TOML ({exc})") from None
+    try:
+        return scene_from_mapping(doc, where=src.stem)
+    except (TypeError, OverflowError) as exc:  # a value of a type no check foresaw
+        raise ValueError(f"{src.name}: {exc}") from None

@@ -1,0 +1,226 @@
+"""The command line a new user meets: each failure a user reported has a test showing its fix;
+every command has --help and --json; user mistakes are one line and exit code 2."""
+
+from __future__ import annotations
+
+import json
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.io
+from click.testing import CliRunner
+
+import holoradar as hr
+from holoradar.app.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+F = 9.9e9
+SCENE = REPO / "examples" / "scenes" / "sand_box.toml"
+
+
+def run(*args: str, ok: bool = True) -> object:
+    res = CliRunner().invoke(main, [str(a) for a in args])
+    if ok:
+        assert res.exit_code == 0, res.output
+    return res
+
+
+def one_line_error(res: object, *needles: str) -> None:
+    """A user mistake: exit code 2, one line starting 'error:', no traceback."""
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    errors = [ln for ln in lines if ln.startswith("error: ")]
+    assert len(errors) == 1, res.output
+    assert "Traceback" not in res.output and "Aborted" not in res.output
+    for n in needles:
+        assert n in errors[0], errors[0]
+
+
+@pytest.fixture(scope="module")
+def holo_nc(tmp_path_factory):
+    d = tmp_path_factory.mktemp("scene")
+    out = d / "holo.nc"
+    run("simulate", SCENE, "-o", out, "--quiet")
+    return out
+
+
+def _point_hologram() -> hr.Hologram:
+    scene = hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))])
+    return hr.simulate(scene, hr.Aperture.grid(32, 0.01), F)
+
+
+def test_every_command_has_help_and_json(holo_nc, tmp_path):
+    for name in main.commands:
+        res = run(name, "--help")
+        assert "--json" in res.output and "--quiet" in res.output, name
+    res = run("theory", "--json")
+    assert json.loads(res.stdout)["wavelength_m"] == pytest.approx(hr.C0 / F, rel=1e-12)
+    res = run("info", holo_nc, "--json")
+    assert json.loads(res.stdout)["readable_as"]["kind"] == "Hologram"
+    res = run("image", holo_nc, "--z", "0.42", "--eps", "2.5", "--tan-delta", "0.005",
+              "--z-surface", "0.3", "-o", tmp_path / "i.nc", "--json")
+    assert json.loads(res.stdout)["out"] == str(tmp_path / "i.nc")
+    res = run("plot", tmp_path / "i.nc", "-o", tmp_path / "p.png", "--json")
+    assert json.loads(res.stdout)["kind"] == "Image"
+    res = run("image", holo_nc, "--z", "0.42", "-o", tmp_path / "q.nc", "--quiet")
+    assert res.stdout == ""  # warnings still go to stderr
+
+
+def test_scene_file_simulates_and_images_through_layers_and_loss(holo_nc, tmp_path):
+    """simulate SCENE.toml -> image through the sand from flags, from --layers (the same
+    sand split in two) and from a TOML medium file: the same focus."""
+    h = hr.load(holo_nc)
+    assert h.data.shape == (16, 16) and isinstance(h.source, hr.PointSource)
+    steps = [s["step"] for s in hr.io.read_history(holo_nc)]
+    assert steps == ["simulate", "save"]
+    (tmp_path / "sand.toml").write_text("[ground]\nsurface = 0.30\neps = 2.5\n"
+                                        "tan_delta = 0.005\n")
+    peaks = []
+    for k, ground in enumerate([["--eps", "2.5", "--tan-delta", "0.005", "--z-surface", "0.3"],
+                                ["--layers", "0.30:2.5+0.0125j,0.40:2.5+0.0125j"],
+                                ["--medium", tmp_path / "sand.toml"]]):
+        res = run("image", holo_nc, "--z", "0.40:0.46:0.005", *ground, "-o",
+                  tmp_path / f"img{k}.nc", "--json", "--no-png")
+        peaks.append(json.loads(res.stdout)["peak_m"])
+    # The same ground three ways: the same image. A ground split in two identical layers
+    # differs from the half-space only by rounding (an interface between equal media
+    # transmits 1 exactly in theory), so the interpolated peaks agree to 1e-9 m.
+    assert peaks[1] == pytest.approx(peaks[0], abs=1e-9) and peaks[2] == peaks[0]
+    # The scene's stronger target (-5, 0) cm 12 cm deep: within a pixel laterally.
+    assert abs(peaks[0][0] + 0.05) <= 0.025 / 4 and abs(peaks[0][1]) <= 0.025 / 4
+    # --sigma adds i*sigma/(omega eps0): 0.0069 S/m at 9.9 GHz is Im(eps) 0.0125, the
+    # same ground as tan_delta 0.005 with eps' 2.5, so again the same peak.
+    res = run("image", holo_nc, "--z", "0.40:0.46:0.005", "--eps", "2.5", "--sigma",
+              str(0.0125 * 2 * np.pi * F * 8.8541878128e-12), "--z-surface", "0.3", "-o",
+              tmp_path / "s.nc", "--json", "--no-png")
+    assert json.loads(res.stdout)["peak_m"] == pytest.approx(peaks[0], abs=1e-9)
+
+
+def test_scene_file_errors_name_the_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    for text, needle in [
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = -1\n", "aperture.pitch must be > 0"),
+        ("frequency = 9.9\n[aperture]\nn = 16\npitch = 0.02\n", "below 100 MHz: given in GHz"),
+        ("frequency = 9.9e9\n[aperture]\nn = 'x'\npitch = 0.02\n", "aperture.n must be an "
+                                                                  "integer"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[ground]\nsurface = 0.3\n"
+         "eps = -4\n", "negative real part"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\ncolour = 1\n",
+         "unknown key(s) ['colour']"),
+        ("frequency = 9.9e9\n[[target]]\nposition = [0, 0]\n", "missing table [aperture]"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[[target]]\nposition = [0, 0]\n",
+         "target[0].position must be a list of 3 numbers"),
+        ("frequency = [", "not valid TOML"),
+    ]:
+        bad.write_text(text)
+        res = run("simulate", bad, "-o", tmp_path / "h.nc", ok=False)
+        one_line_error(res, needle)
+        assert not (tmp_path / "h.nc").exists()
+
+
+def test_reported_failures_are_fixed(tmp_path):
+    """Each failure of the first report, as a new user met it, and what happens now."""
+    h = _point_hologram()
+    # A .npy crashed with a TypeError: now it reads, given its coordinates.
+    np.save(tmp_path / "a.npy", h.data)
+    one_line_error(run("image", tmp_path / "a.npy", "--z", "0.3", "-o", tmp_path / "a.nc",
+                       ok=False), "no frequency found")
+    run("image", tmp_path / "a.npy", "--z", "0.3", "-o", tmp_path / "a.nc", "--layout",
+        "pitch=0.01,frequency=9.9e9", "-q")
+    # .csv, .mat, .h5 got numpy's advice to load 'unsafely': now they are read.
+    scipy.io.savemat(tmp_path / "b.mat", {"data": h.data, "x": h.x, "y": h.y, "frequency": F})
+    res = run("image", tmp_path / "b.mat", "--z", "0.3", "-o", tmp_path / "b.nc", "--json")
+    assert abs(json.loads(res.stdout)["peak_m"][2] - 0.3) < 0.01
+    # Empty and truncated files gave tracebacks or 'Aborted!': now one line, exit 2.
+    (tmp_path / "e.npz").write_bytes(b"")
+    one_line_error(run("image", tmp_path / "e.npz", "--z", "0.3", "-o", tmp_path / "e.nc",
+                       ok=False), "is empty")
+    np.savez(tmp_path / "t.npz", data=h.data, x=h.x, y=h.y, frequency=F)
+    blob = (tmp_path / "t.npz").read_bytes()
+    (tmp_path / "t.npz").write_bytes(blob[: len(blob) // 2])
+    one_line_error(run("image", tmp_path / "t.npz", "--z", "0.3", "-o", tmp_path / "t.nc",
+                       ok=False), "t.npz")
+    # Millimetres and GHz produced a confident wrong image with exit code 0.
+    np.savez(tmp_path / "mm.npz", data=h.data, x=h.x * 1e3, y=h.y * 1e3, frequency=F)
+    one_line_error(run("image", tmp_path / "mm.npz", "--z", "0.3", "-o", tmp_path / "m.nc",
+                       ok=False), "millimetres", "length_unit=mm")
+    np.savez(tmp_path / "ghz.npz", data=h.data, x=h.x, y=h.y, frequency=9.9)
+    one_line_error(run("image", tmp_path / "ghz.npz", "--z", "0.3", "-o", tmp_path / "g.nc",
+                       ok=False), "GHz")
+    # --out img.png overwrote the image it had just written: the image must be .nc/.npz.
+    one_line_error(run("image", tmp_path / "b.mat", "--z", "0.3", "-o", tmp_path / "i.png",
+                       ok=False), "must end in")
+    # --out equal to the input replaced the hologram with the image.
+    before = (tmp_path / "b.mat").read_bytes()
+    one_line_error(run("image", tmp_path / "b.nc", "--z", "0.3", "-o", tmp_path / "b.nc",
+                       ok=False), "one of the inputs")
+    assert (tmp_path / "b.mat").read_bytes() == before
+    # A missing output folder failed only after the computation: now before it.
+    one_line_error(run("image", tmp_path / "b.mat", "--z", "0.3", "-o",
+                       tmp_path / "nowhere" / "i.nc", ok=False), "does not exist")
+    # --z 0.3:0.6:0 raised ZeroDivisionError; theory --frequency 0 a traceback.
+    one_line_error(run("image", tmp_path / "b.mat", "--z", "0.3:0.6:0", "-o",
+                       tmp_path / "z.nc", ok=False), "step > 0")
+    one_line_error(run("theory", "--frequency", "0", ok=False), "--frequency")
+    # Nothing was written by any failure above.
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "a.nc", "a.npy", "a.png", "b.mat", "b.nc", "b.png", "e.npz", "ghz.npz", "mm.npz",
+        "t.npz"]
+
+
+def test_outputs_get_the_users_umask(tmp_path):
+    """Every output file was created 0600: now 0666 less the umask, like any file."""
+    h = _point_hologram()
+    src = hr.save(h, tmp_path / "h.nc")
+    old = os.umask(0o022)
+    try:
+        run("image", src, "--z", "0.3", "-o", tmp_path / "i.nc", "-q")
+        run("plot", tmp_path / "i.nc", "-o", tmp_path / "p.png", "-q")
+    finally:
+        os.umask(old)
+    for name in ("i.nc", "i.png", "p.png"):
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o644, name
+
+
+def test_suppress_and_synthesize_from_the_command_line(tmp_path):
+    """The glare of a horn over sand removed by the CLI; three plane-wave views
+    synthesised by the CLI focus where the library's synthesis does."""
+    sand = hr.Medium.half_space(0.3, 2.5)
+    horn = hr.PointSource((0.0, 0.0, -0.05))
+    scene = hr.Scene(sand, horn, [hr.PointTarget((0.05, 0.0, 0.42), 0.01)])
+    h = hr.simulate(scene, hr.Aperture.grid(32, 0.0125), F)
+    src = hr.save(h, tmp_path / "glare.nc")
+    res = run("suppress", src, "--eps", "2.5", "--z-surface", "0.3", "-o", tmp_path / "c.nc",
+              "--json")
+    s = json.loads(res.stdout)
+    clean, rep = hr.suppress_surface(h, sand)
+    # The CLI runs the same library call: the same numbers, exactly.
+    assert s["glare_suppression_db"] == rep.glare_suppression_db
+    assert np.array_equal(hr.load(tmp_path / "c.nc").data, clean.data)
+    one_line_error(run("suppress", src, "-o", tmp_path / "d.nc", ok=False), "needs a ground")
+    ap = hr.Aperture.grid(25, 0.015)
+    files, views = [], []
+    for a in (-20, 0, 20):
+        v = hr.simulate(hr.Scene(source=hr.PlaneWave(np.radians(a), 0.0),
+                                 targets=[hr.PointTarget((0.0, 0.0, 0.5))]), ap, F)
+        views.append(v)
+        # written without their source, as a user's file would be
+        np.savez(tmp_path / f"v{a}.npz", data=v.data, x=v.x, y=v.y, frequency=F)
+        files.append(tmp_path / f"v{a}.npz")
+    one_line_error(run("synthesize", *files, "--z", "0.5", "-o", tmp_path / "s.nc",
+                       ok=False), "no source")
+    res = run("synthesize", *files, "--z", "0.5", "--plane-wave", "-20,0", "--plane-wave",
+              "0,0", "--plane-wave", "20,0", "-o", tmp_path / "s.nc", "--json")
+    ref = hr.synthesize(views, 0.5, upsample=4)
+    assert np.array_equal(hr.load(tmp_path / "s.nc").data, ref.data)
+    assert json.loads(res.stdout)["views"] == 3
+
+
+def test_info_lists_what_a_users_file_holds(tmp_path):
+    np.savez(tmp_path / "u.npz", E_scat=np.ones((3, 4, 4), complex), x_pos=np.arange(4.0))
+    res = run("info", tmp_path / "u.npz")
+    assert "E_scat" in res.output and "(3, 4, 4)" in res.output
+    assert "not readable as a hologram yet" in res.output and "data=E_scat[1]" in res.output
