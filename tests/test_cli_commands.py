@@ -52,10 +52,21 @@ def _point_hologram() -> hr.Hologram:
     return hr.simulate(scene, hr.Aperture.grid(32, 0.01), F)
 
 
+def _leaves(group, path=()):
+    for name, cmd in group.commands.items():
+        if hasattr(cmd, "commands"):
+            assert run(*path, name, "--help").exit_code == 0
+            yield from _leaves(cmd, (*path, name))
+        else:
+            yield (*path, name)
+
+
 def test_every_command_has_help_and_json(holo_nc, tmp_path):
-    for name in main.commands:
-        res = run(name, "--help")
-        assert "--json" in res.output and "--quiet" in res.output, name
+    leaves = list(_leaves(main))
+    assert len(leaves) >= 12
+    for path in leaves:
+        res = run(*path, "--help")
+        assert "--json" in res.output and "--quiet" in res.output, path
     res = run("theory", "--json")
     assert json.loads(res.stdout)["wavelength_m"] == pytest.approx(hr.C0 / F, rel=1e-12)
     res = run("info", holo_nc, "--json")
@@ -224,3 +235,51 @@ def test_info_lists_what_a_users_file_holds(tmp_path):
     res = run("info", tmp_path / "u.npz")
     assert "E_scat" in res.output and "(3, 4, 4)" in res.output
     assert "not readable as a hologram yet" in res.output and "data=E_scat[1]" in res.output
+
+
+def test_calibrate_fit_and_apply_from_files_equal_the_library(tmp_path):
+    """A faulty device's raw references and survey as users' files: the CLI's calibration
+    and calibrated hologram equal the library's exactly; another device is refused."""
+    from holoradar import calibrate as cb
+
+    x = (np.arange(8) - 3.5) * 0.025
+    f = np.array([9.5e9, 9.9e9])
+    horn = hr.PointSource((0.0, -0.25, -0.05), pattern_exponent=2, axis=(0.0, 0.5, 1.0))
+    rng = np.random.default_rng(3)
+    dev = cb.DeviceFaults(dc_i=0.1, dc_q=-0.05, iq_gain=1.1, iq_phase=np.radians(6),
+                          element_gain=np.exp(2j * np.pi * rng.random((8, 8))),
+                          response=np.array([1.0, 0.8j]), conjugate=True, noise=1e-3)
+
+    def write(raw, name):
+        np.savez(tmp_path / name, I=raw.i, Q=raw.q, x=x, y=x, frequency=f)
+        return tmp_path / name
+
+    refs, files = [], []
+    for j, z in enumerate((0.300, 0.304)):
+        field = hr.Hologram(cb.reference_field("plate", x, x, f, horn, plate_range=z), x, x, f,
+                            source=horn)
+        raw = dev.record(field, "HSR-7", repeats=4, seed=j)
+        refs.append(cb.Reference(raw, "plate", plate_range=z))
+        files.append(write(raw, f"plate{j}.npz"))
+    dark = dev.record(hr.Hologram(np.zeros((2, 8, 8)), x, x, f), "HSR-7", repeats=16,
+                      transmitter=False, seed=9)
+    write(dark, "dark.npz")
+    scene = hr.Scene(source=horn, targets=[hr.PointTarget((0.02, 0.0, 0.4), 0.05)])
+    survey = dev.record(hr.simulate(scene, hr.Aperture.grid(8, 0.025), f), "HSR-7", seed=5)
+    write(survey, "survey.npz")
+    # The repeats' axis is a frame axis: declared with the letter t.
+    res = run("calibrate", "fit", "--device", "HSR-7", "--plate", files[0], "0.300", "--plate",
+              files[1], "0.304", "--dark", tmp_path / "dark.npz", "--horn", "0,-0.25,-0.05",
+              "--horn-axis", "0,0.5,1", "--pattern", "2", "--layout", "axes=tfyx", "-o",
+              tmp_path / "HSR-7.nc", "--json")
+    assert json.loads(res.stdout)["iq_sign"] == "I-iQ"
+    ref_cal = cb.fit_calibration(refs, dark=dark, notes="x")
+    cal = cb.Calibration.load(tmp_path / "HSR-7.nc")
+    assert np.array_equal(cal.total_gain, ref_cal.total_gain)
+    run("calibrate", "apply", tmp_path / "survey.npz", "--calibration", tmp_path / "HSR-7.nc",
+        "--device", "HSR-7", "-o", tmp_path / "holo.nc", "-q")
+    assert np.array_equal(hr.load(tmp_path / "holo.nc").data, ref_cal.apply(survey).data)
+    one_line_error(run("calibrate", "apply", tmp_path / "survey.npz", "--calibration",
+                       tmp_path / "HSR-7.nc", "--device", "HSR-8", "-o",
+                       tmp_path / "other.nc", ok=False), "HSR-8")
+    assert not (tmp_path / "other.nc").exists()

@@ -277,6 +277,18 @@ def _aperture(m: Mapping[str, Any], where: str) -> Aperture:
                          monostatic=_bool(m, "monostatic", where, False), pose=pose)
 
 
+def _within(where: str, build: Any, *args: Any) -> Any:
+    """Call ``build``; a library error that does not say where it arose gets ``where``."""
+    try:
+        return build(*args)
+    except ValueError as exc:
+        if str(exc).startswith(where):
+            raise
+        raise ValueError(f"{where}: {exc}") from None
+    except TypeError as exc:  # e.g. a shape given a size it does not take
+        raise ValueError(f"{where}: {exc}") from None
+
+
 def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpec:
     """A :class:`SceneSpec` from a parsed TOML document (see the module's example)."""
     _unknown(doc, {"frequency", "aperture", "ground", "source", "target", "simulate"}, where)
@@ -297,12 +309,14 @@ def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpe
     fc = float(np.mean(fl))
     if "aperture" not in doc:
         raise ValueError(f"{where}: missing table [aperture] (n, pitch)")
-    aperture = _aperture(_table(doc, "aperture", where), f"{where}.aperture")
+    aperture = _within(f"{where}.aperture", _aperture, _table(doc, "aperture", where),
+                       f"{where}.aperture")
     ground = _table(doc, "ground", where)
-    medium = medium_from_mapping(ground, fc, f"{where}.ground") if ground else \
-        Medium.free_space()
-    source = _source(_table(doc, "source", where), f"{where}.source")
-    targets = _targets(doc.get("target", []), f"{where}.target")
+    medium = _within(f"{where}.ground", medium_from_mapping, ground, fc, f"{where}.ground") \
+        if ground else Medium.free_space()
+    source = _within(f"{where}.source", _source, _table(doc, "source", where),
+                     f"{where}.source")
+    targets = _within(f"{where}.target", _targets, doc.get("target", []), f"{where}.target")
     sim = _table(doc, "simulate", where)
     _unknown(sim, {"include_surface", "include_direct", "include_targets", "snr_db", "seed"},
              f"{where}.simulate")

@@ -1,3 +1,155 @@
-"""placeholder"""
+"""``holoradar calibrate fit`` and ``holoradar calibrate apply``: a device's calibration."""
 
-COMMANDS: list = []
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import Reporter, input_history, output_options, triple
+
+__all__ = ["COMMANDS"]
+
+
+def _raw(path: Path, layout: str | None, device: str, source: Any, check: bool) -> Any:
+    """Raw I and Q frames from any readable file (the field read as I + iQ, as recorded)."""
+    from ...calibrate import RawFrames
+    from ...io import load
+
+    h = load(path, layout=layout, check=check)
+    if not hasattr(h, "pose") or not hasattr(h, "monostatic"):
+        raise ValueError(f"{path.name} holds an image, not raw frames")
+    return RawFrames(h.data.real, h.data.imag, h.x, h.y, h.frequency, device, source=source,
+                     pose=None if h.pose.is_identity else h.pose)
+
+
+def _horn(horn: str | None, pattern: float, axis: str | None) -> Any:
+    from ...physics.sources import PointSource
+
+    if horn is None:
+        return None
+    return PointSource(triple(horn, "--horn"), pattern_exponent=pattern,
+                       axis=(0.0, 0.0, 1.0) if axis is None else triple(axis, "--horn-axis"))
+
+
+_LAYOUT_HELP = ("Where I and Q are in the files (see holoradar image --help); the field is "
+                "read as I + iQ as recorded.")
+
+
+@click.group()
+def calibrate() -> None:
+    """Fit a device's calibration from reference measurements, or apply one.
+
+    A calibration is a file of its own (NetCDF-4) holding the device's identity;
+    it is applied only to frames of that device, array and frequencies.
+    """
+
+
+@calibrate.command(name="fit")
+@click.option("--device", required=True, help="The device's identity (serial number).")
+@click.option("--plate", "plates", nargs=2, multiple=True, metavar="FILE RANGE",
+              help="Repeats of a metal plate parallel to the array at RANGE metres (its "
+                   "front face). Give two plates about lambda/8 apart to detect the I/Q sign.")
+@click.option("--empty", "empties", multiple=True,
+              type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="Repeats with nothing in front of the array (the horn's direct wave only).")
+@click.option("--dark", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              default=None, help="Dark frames (transmitter off) for the DC offsets.")
+@click.option("--horn", required=True, help="The horn's position x,y,z in metres.")
+@click.option("--horn-axis", default=None, help="The horn's boresight x,y,z (default +z).")
+@click.option("--pattern", default=0.0, show_default=True, type=click.FloatRange(min=0),
+              help="Horn pattern exponent m of cos^m.")
+@click.option("--iq-sign", type=click.Choice(["detect", "I+iQ", "I-iQ"]), default="detect",
+              show_default=True, help="The I/Q sign if known; detect needs two references.")
+@click.option("--layout", default=None, metavar="KEY=VALUE,...", help=_LAYOUT_HELP)
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="The calibration file, .nc.")
+@click.option("--force", is_flag=True, help="Replace --out if it exists.")
+@output_options
+def fit(device: str, plates: tuple[tuple[str, str], ...], empties: tuple[Path, ...],
+        dark: Path | None, horn: str, horn_axis: str | None, pattern: float, iq_sign: str,
+        layout: str | None, out: Path, force: bool, report: Reporter) -> None:
+    """Fit a calibration: DC offsets, I/Q imbalance and sign, element gains, dead and
+    noisy elements, the response of each frequency."""
+    from ...calibrate import Reference, fit_calibration
+    from ...io.output import check_output
+
+    plate_files = []
+    for f, r in plates:
+        p = Path(f)
+        if not p.is_file():
+            raise click.BadParameter(f"{f!r} is not a file", param_hint="--plate")
+        try:
+            rng = float(r)
+        except ValueError:
+            raise click.BadParameter(f"the plate's range must be metres, got {r!r}",
+                                     param_hint="--plate") from None
+        plate_files.append((p, rng))
+    inputs = [p for p, _ in plate_files] + list(empties) + ([dark] if dark else [])
+    if not plate_files and not empties:
+        raise click.BadParameter("give at least one reference: --plate FILE RANGE or --empty "
+                                 "FILE", param_hint="--plate/--empty")
+    check_output(out, suffixes=[".nc"], inputs=inputs, overwrite=force, name="--out")
+    src = _horn(horn, pattern, horn_axis)
+    refs = [Reference(_raw(p, layout, device, src, True), "plate", plate_range=r)
+            for p, r in plate_files]
+    refs += [Reference(_raw(p, layout, device, src, True), "empty") for p in empties]
+    dark_raw = None if dark is None else _raw(dark, layout, device, None, False)
+    cal = fit_calibration(refs, dark=dark_raw, iq_sign=None if iq_sign == "detect" else iq_sign,
+                          notes=f"holoradar calibrate fit from {[p.name for p in inputs]}")
+    cal.save(out, overwrite=force)
+    mask = np.asarray(cal.mask)
+    s = {"out": str(out), "device": cal.device, "iq_sign": cal.iq_sign,
+         "iq_gain": cal.iq_gain, "iq_phase_rad": cal.iq_phase,
+         "dead_elements": int(np.sum(cal.dead)), "noisy_elements": int(np.sum(cal.noisy)),
+         "flagged": int(mask.sum()), "provenance": cal.provenance}
+    report.done(s, [
+        f"calibration of {cal.device}: I/Q sign {cal.iq_sign}, Q gain "
+        f"{np.ravel(cal.iq_gain)[0]:.4g}, Q phase {np.degrees(np.ravel(cal.iq_phase)[0]):.3g} deg,"
+        f" {s['dead_elements']} dead and {s['noisy_elements']} noisy element(s) flagged",
+        f"wrote {out}",
+    ])
+
+
+@calibrate.command(name="apply")
+@click.argument("raw_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--calibration", "cal_file", required=True,
+              type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="The device's calibration file (from calibrate fit).")
+@click.option("--device", required=True,
+              help="The identity of the device that recorded RAW_FILE (must be the "
+                   "calibration's).")
+@click.option("--horn", default=None,
+              help="The horn's position x,y,z for these frames (default: the calibration's).")
+@click.option("--horn-axis", default=None, help="The horn's boresight x,y,z (default +z).")
+@click.option("--pattern", default=0.0, show_default=True, type=click.FloatRange(min=0),
+              help="Horn pattern exponent (with --horn).")
+@click.option("--layout", default=None, metavar="KEY=VALUE,...", help=_LAYOUT_HELP)
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="The calibrated hologram, .nc.")
+@click.option("--force", is_flag=True, help="Replace --out if it exists.")
+@output_options
+def apply_cmd(raw_file: Path, cal_file: Path, device: str, horn: str | None,
+              horn_axis: str | None, pattern: float, layout: str | None, out: Path,
+              force: bool, report: Reporter) -> None:
+    """Calibrate RAW_FILE's frames into a hologram that the other commands image."""
+    from ...calibrate import Calibration
+    from ...io import save
+    from ...io.output import check_output
+
+    check_output(out, suffixes=[".nc", ".nc4"], inputs=[raw_file, cal_file], overwrite=force,
+                 name="--out")
+    cal = Calibration.load(cal_file)
+    raw = _raw(raw_file, layout, device, _horn(horn, pattern, horn_axis), True)
+    holo = cal.apply(raw)
+    save(holo, out, overwrite=force,
+         history=[*input_history(raw_file, layout), cal.history_step()])
+    report.done({"out": str(out), "device": device, "calibration": str(cal_file),
+                 "shape": list(holo.data.shape)},
+                [f"calibrated {raw_file.name} with {cal_file.name} ({cal.device})",
+                 f"wrote {out}"])
+
+
+COMMANDS = [calibrate]
