@@ -63,7 +63,7 @@ def _leaves(group, path=()):
 
 def test_every_command_has_help_and_json(holo_nc, tmp_path):
     leaves = list(_leaves(main))
-    assert len(leaves) >= 12
+    assert len(leaves) >= 13
     for path in leaves:
         res = run(*path, "--help")
         assert "--json" in res.output and "--quiet" in res.output, path
@@ -283,3 +283,38 @@ def test_calibrate_fit_and_apply_from_files_equal_the_library(tmp_path):
                        tmp_path / "HSR-7.nc", "--device", "HSR-8", "-o",
                        tmp_path / "other.nc", ok=False), "HSR-8")
     assert not (tmp_path / "other.nc").exists()
+
+
+def test_batch_and_mosaic_from_the_command_line(tmp_path):
+    """Frames placed by their pose imaged into a store; a truncated frame is reported by
+    name and skipped (or fails the run with --strict); a rerun resumes; the mosaic puts
+    the stone where it is."""
+    scene = hr.Scene(targets=[hr.PointTarget((0.12, 0.0, 0.3), 0.05)])
+    (tmp_path / "s").mkdir()
+    for k, x0 in enumerate((0.0, 0.1, 0.2)):
+        ap = hr.Aperture.grid(12, 0.01, pose=hr.Pose((x0, 0.0, 0.0)))
+        hr.save(hr.simulate(scene, ap, F), tmp_path / "s" / f"f{k}.nc")
+    blob = (tmp_path / "s" / "f0.nc").read_bytes()
+    (tmp_path / "s" / "f3.nc").write_bytes(blob[: len(blob) // 2])
+    pattern = str(tmp_path / "s" / "*.nc")
+    store = tmp_path / "survey.zarr"
+    res = run("batch", pattern, "-o", store, "--z", "0.3", "--upsample", "2", "--strict",
+              "--scheduler", "synchronous", ok=False)
+    one_line_error(res, "f3.nc")
+    res = run("batch", pattern, "-o", store, "--z", "0.3", "--upsample", "2", "--scheduler",
+              "synchronous", "--json")
+    s = json.loads(res.stdout)
+    # the strict run kept the frames it had finished: this run resumes after them
+    assert s["done"] + s["resumed"] == 3
+    assert [Path(k["name"]).name for k in s["skipped"]] == ["f3.nc"]  # named as given
+    assert "warning: skipped " in res.output and "f3.nc" in res.output
+    res = run("batch", pattern, "-o", store, "--z", "0.3", "--upsample", "2", "--scheduler",
+              "synchronous", "--json")
+    assert json.loads(res.stdout)["resumed"] == 3
+    one_line_error(run("batch", pattern, "-o", store, "--z", "0.35", "--scheduler",
+                       "synchronous", ok=False), "other settings")
+    res = run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc", "--json")
+    peak = json.loads(res.stdout)["peak_m"]
+    # The stone at x = 0.12 m: within one map pixel (pitch / upsample = 5 mm).
+    assert abs(peak[0] - 0.12) <= 0.005 and abs(peak[1]) <= 0.005
+    run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.png", "-q")

@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 import re
 import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -19,12 +21,14 @@ _BLOCK = re.compile(r"```console\n(.*?)```", re.S)
 
 
 def commands(page: Path) -> list[list[str]]:
-    """The ``$ holoradar ...`` lines of a page's console blocks."""
+    """The ``$ holoradar ...`` and ``$ python ...`` lines of a page's console blocks."""
     out = []
     for block in _BLOCK.findall(page.read_text()):
         for line in block.splitlines():
             if line.startswith("$ holoradar "):
                 out.append(shlex.split(line[len("$ holoradar "):]))
+            elif line.startswith("$ python "):
+                out.append(["python", *shlex.split(line[len("$ python "):])])
     return out
 
 
@@ -38,6 +42,11 @@ def test_every_documented_command_runs(page, tmp_path, monkeypatch):
     (tmp_path / "examples").symlink_to(REPO / "examples")
     monkeypatch.chdir(tmp_path)
     for args in commands(page):
+        if args[0] == "python":
+            done = subprocess.run([sys.executable, *args[1:]], capture_output=True, text=True,
+                                  timeout=120)
+            assert done.returncode == 0, f"{' '.join(args)}\n{done.stderr}"
+            continue
         res = CliRunner().invoke(main, [*args, "--quiet"] if args[0] != "demo" else
                                  [*args, "--upsample", "2", "--quiet"])
         assert res.exit_code == 0, f"holoradar {' '.join(args)}\n{res.output}"

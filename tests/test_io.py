@@ -88,7 +88,9 @@ def test_history_is_kept(tmp_path):
     steps = [{"step": "migrate", "parameters": {"z": 0.4}}]
     path = hr.save(IMAGES["plane"], tmp_path / "i.nc", history=steps)
     got = hr.io.read_history(path)
-    assert got[0] == steps[0] and got[1]["step"] == "save"
+    # each step is kept as given, stamped with holoradar's version and the time
+    assert {k: got[0][k] for k in steps[0]} == steps[0] and got[1]["step"] == "save"
+    assert got[0]["holoradar"] == hr.__version__ and got[0]["time"]
 
 
 def test_output_is_never_destroyed(tmp_path):

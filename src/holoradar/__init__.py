@@ -14,7 +14,7 @@ Examples
 0.42
 """
 
-from . import theory
+from . import calibrate, survey, theory
 from ._validate import AliasingWarning
 from .analysis.oblique_plan import ObliquePlan, plan_oblique
 from .data.hologram import C0, Hologram, Image
@@ -64,6 +64,7 @@ __all__ = [
     "__version__",
     "align_phases",
     "apply_calibration",
+    "calibrate",
     "conjugate",
     "estimate_permittivity",
     "iq_convention",
@@ -75,6 +76,7 @@ __all__ = [
     "save",
     "simulate",
     "suppress_surface",
+    "survey",
     "synthesize",
     "theory",
 ]

@@ -258,7 +258,10 @@ def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = Non
         if img.has_z_axis else np.abs(img.data).reshape((-1, 1, img.y.size, img.x.size))[0]
     panels = [vol[i] for i in idx]
     gmax = max(float(p.max()) for p in panels) or 1.0
-    fig = Figure(figsize=(max(6.0, 4.6 * len(panels)), 4.8), layout="constrained")
+    aspect = float(np.ptp(img.y) / np.ptp(img.x)) if np.ptp(img.x) > 0 else 1.0
+    width = 4.6 if aspect >= 0.8 else 9.0  # a long strip (a survey map) gets room
+    height = min(4.8, max(2.8, (width - 1.8) * aspect + 1.5))
+    fig = Figure(figsize=(max(6.0, width * len(panels)), height), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(panels)))
     for ax, p, i in zip(axes, panels, idx, strict=True):
         ref = gmax if shared else (float(p.max()) or 1.0)

@@ -178,8 +178,8 @@ def medium_from_mapping(m: Mapping[str, Any], frequency: float, where: str = "[g
 
     Examples
     --------
-    >>> medium_from_mapping({"surface": 0.3, "eps": 2.5, "tan_delta": 0.005}, 9.9e9).eps
-    (1.0, (2.5+0.0125j))
+    >>> medium_from_mapping({"surface": 0.3, "eps": 2.5, "tan_delta": 0.005}, 9.9e9).eps[1]
+    (2.5+0.0125j)
     """
     if not isinstance(m, Mapping):
         raise ValueError(f"{where} must be a table, got {type(m).__name__}")

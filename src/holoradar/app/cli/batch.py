@@ -1,3 +1,133 @@
-"""placeholder"""
+"""``holoradar batch`` (image every frame of a survey on Dask) and ``holoradar mosaic``."""
 
-COMMANDS: list = []
+from __future__ import annotations
+
+import glob
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import (
+    Reporter,
+    depth_ranges,
+    medium_from_options,
+    medium_options,
+    output_options,
+)
+
+__all__ = ["COMMANDS"]
+
+
+def _expand(patterns: tuple[str, ...]) -> list[Path]:
+    """Frame files from names or quoted glob patterns ('survey/*.nc'), in sorted order."""
+    out: list[Path] = []
+    for pat in patterns:
+        if any(c in pat for c in "*?["):
+            hits = sorted(glob.glob(pat))
+            if not hits:
+                raise click.BadParameter(f"{pat!r} matches no file", param_hint="FRAMES")
+            out += [Path(h) for h in hits]
+        else:
+            out.append(Path(pat))
+    return out
+
+
+@click.command()
+@click.argument("frames", nargs=-1, required=True)
+@click.option("-o", "--out", required=True, type=click.Path(path_type=Path),
+              help="The survey's Zarr store (a folder ending in .zarr).")
+@click.option("--z", "z", required=True, help="Range(s) in metres: 0.4 or start:stop:step.")
+@medium_options
+@click.option("--method", type=click.Choice(["angular", "fresnel"]), default="angular",
+              show_default=True)
+@click.option("--upsample", default=1, show_default=True, type=click.IntRange(1, 32),
+              help="Image pixels per element pitch.")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="A dask.distributed scheduler (tcp://host:8786), or threads, processes "
+                   "or synchronous; default: local processes, one per core.")
+@click.option("--strict", is_flag=True,
+              help="Stop at the first bad frame instead of reporting and skipping it.")
+@click.option("--force", is_flag=True,
+              help="Start the store afresh (settings changed) instead of refusing.")
+@output_options
+def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any], method: str,
+          upsample: int, scheduler: str | None, strict: bool, force: bool,
+          report: Reporter) -> None:
+    """Image every frame of a survey with the same settings into one Zarr store.
+
+    FRAMES: hologram files or quoted patterns ('survey/*.nc'). A frame's position
+    is its pose's centre (or the centre of its coordinates). Bad frames are
+    reported and skipped; a rerun resumes, imaging only frames not yet done.
+    """
+    from ...survey import run_batch
+
+    files = _expand(frames)
+    zs = depth_ranges(z)
+    freq = 1.0
+    if medium_spec["sigma"] is not None:  # a conductivity needs the frequency
+        from ...io import load
+
+        freq = float(np.mean(load(files[0]).frequencies))
+    medium = medium_from_options(medium_spec, freq)
+    s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
+                  scheduler=scheduler, strict=strict, overwrite=force,
+                  progress=report.progress and not report.as_json)
+    for w in s.get("warnings", []):  # raised in the workers: shown here once each
+        category, _, message = w.partition(": ")
+        click.echo(f"warning: {' '.join(message.split())} ({category})", err=True)
+    for sk in s["skipped"]:
+        click.echo(f"warning: skipped {sk['name']}: {' '.join(sk['reason'].split())}",
+                   err=True)
+    report.done(s, [
+        f"imaged {s['done']} frame(s), {s['resumed']} already done, {len(s['skipped'])} "
+        f"skipped, in {s['seconds']:.1f} s ({s['scheduler']})",
+        f"wrote {out}",
+    ])
+
+
+@click.command()
+@click.argument("store", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.option("--depth", required=True, type=float,
+              help="Range of the plane (m); the stored plane nearest to it is used.")
+@click.option("--pitch", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Pixel step of the map, m (default: the frames' pixel step).")
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="The map: .png (a picture) or .nc (an image holoradar.load reads).")
+@click.option("--db", "db_range", type=click.FloatRange(min=1), default=None,
+              help="Draw 20 log10 |E| over this many dB (with .png).")
+@click.option("--z-surface", type=float, default=None,
+              help="Ground surface range, m: label the plane with its depth below it.")
+@click.option("--force", is_flag=True, help="Replace --out if it exists.")
+@output_options
+def mosaic(store: Path, depth: float, pitch: float | None, out: Path, db_range: float | None,
+           z_surface: float | None, force: bool, report: Reporter) -> None:
+    """Stitch a survey store into one plan-view map at a depth, overlapping frames blended."""
+    from ...io import save
+    from ...io.output import check_output
+    from ...survey import mosaic as run
+    from .. import plotting
+    from ..atomic import write_atomic
+
+    check_output(out, suffixes=[".png", ".nc"], inputs=[store], overwrite=force, name="--out")
+    img = run(store, depth, pitch=pitch)
+    if out.suffix.lower() == ".nc":
+        save(img, out, overwrite=force, history=[{"step": "mosaic", "input": store.name,
+                                                  "parameters": {"depth": depth,
+                                                                 "pitch": pitch}}])
+    else:
+        fig = plotting.plot_planes(img, [float(img.z[0])], db_range=db_range,
+                                   z_surface=z_surface, title=f"{store.name}: mosaic")
+        write_atomic(out, plotting.to_png(fig))
+    pk = img.peak()
+    report.done({"out": str(out), "plane_m": float(img.z[0]), "peak_m": list(pk),
+                 "shape": list(img.data.shape)}, [
+        f"mosaic of {store.name} at z = {float(img.z[0]) * 100:.1f} cm: "
+        f"{img.x.size} x {img.y.size} pixels, brightest at x={pk[0] * 100:.1f} "
+        f"y={pk[1] * 100:.1f} cm",
+        f"wrote {out}",
+    ])
+
+
+COMMANDS = [batch, mosaic]

@@ -1,0 +1,216 @@
+"""``run_batch``: image every frame of a survey with the same settings, on Dask."""
+
+from __future__ import annotations
+
+import os
+import time
+import uuid
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from ..io.output import check_output
+from ..physics.medium import Medium
+from . import schedule
+from .frames import FrameGeometry
+from .settings import Settings
+from .store import create_store, is_survey, read_index, register_frames, stored_settings
+from .worker import Job, process_chunk, read_frame
+
+__all__ = ["run_batch"]
+
+
+def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike[str], *,
+              z: float | Sequence[float], medium: Medium | None = None,
+              method: str = "angular", upsample: int = 1, scheduler: str | None = None,
+              strict: bool = False, overwrite: bool = False,
+              progress: bool = False) -> dict[str, Any]:
+    """Image every frame of a survey with the same settings into one Zarr store.
+
+    Each frame (a hologram file written by :func:`holoradar.save`) is read with
+    :func:`holoradar.load`, migrated with :func:`holoradar.migrate` and written
+    into its own slot of the store together with its position along the survey
+    (the world position of the centre of its element grid: ``pose.center`` for
+    the usual centred grids, the centre of the coordinates for the identity
+    pose; :func:`~holoradar.survey.frames.frame_position`). The work runs on
+    Dask; the layout of the store is in :mod:`holoradar.survey.store`.
+
+    Parameters
+    ----------
+    frames : sequence of path
+        Hologram files (``.nc``). Duplicates are imaged once.
+    store : path
+        The Zarr store to write, ending in ``.zarr``; its folder must exist and
+        it must not be one of the frames.
+    z : float or sequence of float
+        Ranges of the image planes from the aperture, metres (>= 0).
+    medium : Medium, optional
+        Layered ground (None: free space).
+    method : {"angular", "fresnel"}
+        Migration method (:func:`holoradar.migrate`).
+    upsample : int
+        Output pixels per element pitch.
+    scheduler : str, optional
+        None: Dask's local ``"processes"`` scheduler (one process per core);
+        ``"threads"``, ``"processes"`` or ``"synchronous"``: that local
+        scheduler; anything else: the address of a ``dask.distributed``
+        scheduler (``"tcp://host:8786"``), whose workers must see the frames and
+        the store at the same paths.
+    strict : bool
+        Stop at the first frame that cannot be imaged (raise ``ValueError``
+        naming it); the frames finished before stay in the store. Default
+        False: such frames are reported in the summary and skipped.
+    overwrite : bool
+        Start a new store even if one exists (the old one is removed once the
+        new layout is in place). Default False: an existing store of the same
+        settings is resumed: frames marked done are not imaged again.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    dict
+        ``done`` (frames imaged by this run), ``resumed`` (frames found done in
+        the store and not imaged again), ``skipped`` (list of ``{"name",
+        "reason"}``), ``seconds`` (wall time of the run), ``frames`` (distinct
+        frames asked), ``store`` (its path), ``scheduler``, ``workers`` and
+        ``warnings`` (each distinct warning the workers raised, once, as
+        ``"Category: message"``).
+
+    Raises
+    ------
+    ValueError
+        No frames; a bad store path (suffix, folder, equal to a frame, an
+        existing folder that is not a survey store); an existing store made
+        with other settings (unless ``overwrite``); a bad scheduler; no frame
+        can be imaged; with ``strict``, the first frame that cannot be imaged.
+
+    Notes
+    -----
+    All frames must share the grid, pitch, frequencies, kind (array or
+    transceiver) and aperture height of the first readable frame (of the store,
+    when resuming); a frame that differs is skipped with the reason. Frames
+    must be level (no tilt). Each frame's result is bit for bit that of
+    ``migrate(load(frame), z, medium=..., method=..., upsample=...)``.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, numpy as np
+    >>> import holoradar as hr
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> x = (np.arange(8) - 3.5) * 0.01
+    >>> paths = [hr.save(hr.Hologram(np.ones((8, 8)), x, x, 9.9e9,
+    ...                               pose=hr.Pose((0.05 * i, 0.0, 0.0))), d / f"f{i}.nc")
+    ...          for i in range(3)]
+    >>> s = run_batch(paths, d / "survey.zarr", z=[0.2, 0.3], scheduler="synchronous")
+    >>> s["done"], s["resumed"], s["skipped"]
+    (3, 0, [])
+    >>> run_batch(paths, d / "survey.zarr", z=[0.2, 0.3], scheduler="synchronous")["resumed"]
+    3
+    """
+    t0 = time.perf_counter()
+    settings = Settings.make(z, medium, method, upsample)
+    sched = schedule.check_scheduler(scheduler)
+    if isinstance(frames, str | os.PathLike):
+        raise ValueError("frames must be a sequence of paths (a list), not one path")
+    given = [Path(f) for f in frames]
+    if not given:
+        raise ValueError("frames: no frames given")
+    target = check_output(store, suffixes=[".zarr"], inputs=given, overwrite=True, name="store")
+    inside = [p for p in given if target.resolve() in p.resolve().parents]
+    if inside:
+        raise ValueError(f"store {str(target)!r} holds the frame {str(inside[0])!r}: refusing "
+                         "to write into (or replace) the folder of the data")
+    exists = target.exists()
+    if exists and not is_survey(target):
+        raise ValueError(f"store {str(target)!r} exists and is not a holoradar survey store: "
+                         "refusing to touch it (choose another path or remove it)")
+
+    # A cluster is reached before anything is written (an unreachable address is an error).
+    client = schedule.connect(sched) if sched not in schedule.LOCAL else None
+    try:
+        summary = _run(given, target, settings, sched, client, strict=bool(strict),
+                       overwrite=overwrite, exists=exists, progress=progress)
+    finally:
+        if client is not None:
+            client.close()
+    summary["seconds"] = time.perf_counter() - t0
+    return summary
+
+
+def _run(given: list[Path], target: Path, settings: Settings, sched: str, client: Any, *,
+         strict: bool, overwrite: bool, exists: bool, progress: bool) -> dict[str, Any]:
+    """The run itself, once the arguments are checked (see :func:`run_batch`)."""
+    # Distinct frames, and the checks that need no reading, before anything is written.
+    frames_in: list[tuple[Path, str]] = []  # (absolute path, name as given)
+    seen: set[Path] = set()
+    skipped: list[dict[str, str]] = []
+    for p in given:
+        key = p.resolve()
+        if key in seen:
+            continue
+        seen.add(key)
+        problem = (None if p.is_file() else "is not a file") or \
+            ("is empty" if p.stat().st_size == 0 else None)
+        if problem:
+            _skip(skipped, str(p), problem, strict)
+        else:
+            frames_in.append((key, str(p)))
+    n_frames = len(seen)
+
+    if exists and not overwrite:
+        old, geometry = stored_settings(target)
+        diff = old.differences(settings)
+        if diff:
+            raise ValueError(f"store {str(target)!r} was made with other settings ("
+                             + "; ".join(diff) + "): pass overwrite=True (--force on the "
+                             "command line) to start it again, or choose another store")
+    else:
+        found, refused = _reference(frames_in, strict)
+        for name, reason in refused:
+            skipped.append({"name": name, "reason": reason})
+        refused_names = {name for name, _ in refused}
+        frames_in = [f for f in frames_in if f[1] not in refused_names]
+        if found is None:
+            raise ValueError(f"none of the {n_frames} frames can be imaged: "
+                             + "; ".join(f"{s['name']}: {s['reason']}" for s in skipped[:3]))
+        geometry = found
+        create_store(target, settings, geometry, replace=exists)
+
+    slots = register_frames(target, [p for p, _ in frames_in])
+    done = read_index(target)["done"]
+    todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, frames_in, strict=True)
+            if not done[slot]]
+    workers = schedule.cluster_workers(client) if client is not None \
+        else schedule.local_workers(sched)
+    job = Job(str(target), uuid.uuid4().hex, settings, geometry, strict)
+    records = schedule.run_tasks(process_chunk, schedule.split(todo, workers), job, sched,
+                                 progress=progress, client=client) if todo else []
+    skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
+                if r["status"] == "skipped"]
+    return {"store": str(target), "frames": n_frames,
+            "done": sum(r["status"] == "done" for r in records),
+            "resumed": len(frames_in) - len(todo), "skipped": skipped, "seconds": 0.0,
+            "scheduler": sched, "workers": workers,
+            "warnings": sorted({w for r in records for w in r.get("warnings", [])})}
+
+
+def _skip(skipped: list[dict[str, str]], name: str, reason: str, strict: bool) -> None:
+    if strict:
+        raise ValueError(f"frame {name!r}: {reason} (strict: nothing was written)")
+    skipped.append({"name": name, "reason": reason})
+
+
+def _reference(frames: list[tuple[Path, str]],
+               strict: bool) -> tuple[FrameGeometry | None, list[tuple[str, str]]]:
+    """The geometry of the first frame that can be read, and the frames refused before it."""
+    refused: list[tuple[str, str]] = []
+    for path, name in frames:
+        holo, problem = read_frame(str(path), None)
+        if holo is not None:
+            return FrameGeometry.of(holo), refused
+        assert problem is not None
+        if strict:
+            raise ValueError(f"frame {name!r}: {problem} (strict: nothing was written)")
+        refused.append((name, problem))
+    return None, refused

@@ -1,0 +1,104 @@
+"""The imaging settings of a survey: one set for every frame, kept in the store.
+
+A rerun on an existing store must ask for the same settings (the frames it
+resumes were imaged with them); :meth:`Settings.differences` says what differs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._validate import check_nonnegative_ranges
+from ..physics.medium import Medium
+
+__all__ = ["Settings"]
+
+
+@dataclass(frozen=True, eq=False)
+class Settings:
+    """Planes, ground and method shared by every frame of a survey.
+
+    Attributes
+    ----------
+    z : ndarray
+        Ranges of the image planes from the aperture, metres (1-D, >= 0).
+    medium : Medium or None
+        Layered ground (None: free space).
+    method : {"angular", "fresnel"}
+        Migration method.
+    upsample : int
+        Output pixels per element pitch.
+
+    Examples
+    --------
+    >>> s = Settings.make([0.2, 0.3], None, "angular", 1)
+    >>> Settings.from_dict(s.to_dict()).differences(s)
+    []
+    >>> s.differences(Settings.make(0.25, None, "angular", 1))
+    ['z: the store has [0.2, 0.3] m, this run asks [0.25] m']
+    """
+
+    z: np.ndarray
+    medium: Medium | None
+    method: str
+    upsample: int
+
+    @classmethod
+    def make(cls, z: float | Sequence[float] | np.ndarray, medium: Medium | None, method: str,
+             upsample: int) -> Settings:
+        """Validated settings (``ValueError`` on a bad value)."""
+        zs = np.array(check_nonnegative_ranges(z, "z"), dtype=float).ravel()
+        if medium is not None and not isinstance(medium, Medium):
+            raise ValueError(f"medium must be a holoradar.Medium or None, got "
+                             f"{type(medium).__name__}")
+        if method not in ("angular", "fresnel"):
+            raise ValueError(f"method must be 'angular' or 'fresnel', got {method!r}")
+        if isinstance(upsample, bool) or not isinstance(upsample, int | np.integer) \
+                or upsample < 1:
+            raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
+        zs.setflags(write=False)
+        return cls(zs, medium, str(method), int(upsample))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form: numbers, lists and strings only (complex as ``[re, im]``)."""
+        med = None if self.medium is None else {
+            "z_interfaces_m": [float(v) for v in self.medium.z_interfaces],
+            "eps": [[float(complex(e).real), float(complex(e).imag)] for e in self.medium.eps],
+            "polarization": self.medium.polarization}
+        return {"z_m": [float(v) for v in self.z], "medium": med, "method": self.method,
+                "upsample": self.upsample}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Settings:
+        """Inverse of :meth:`to_dict`."""
+        m = d.get("medium")
+        medium = None if m is None else Medium(
+            tuple(m["z_interfaces_m"]), tuple(complex(re, im) for re, im in m["eps"]),
+            m["polarization"])
+        return cls.make(d["z_m"], medium, d["method"], int(d["upsample"]))
+
+    def differences(self, asked: Settings) -> list[str]:
+        """What ``asked`` changes against these (stored) settings, one line each."""
+        mine, other = self.to_dict(), asked.to_dict()
+        out = []
+        for key, label, unit in (("z_m", "z", " m"), ("medium", "medium", ""),
+                                 ("method", "method", ""), ("upsample", "upsample", "")):
+            if mine[key] != other[key]:
+                out.append(f"{label}: the store has {_show(mine[key])}{unit}, this run asks "
+                           f"{_show(other[key])}{unit}")
+        return out
+
+
+def _show(v: Any) -> str:
+    if v is None:
+        return "free space"
+    if isinstance(v, dict):
+        eps = ", ".join(f"{complex(re, im):g}" for re, im in v["eps"])
+        return f"interfaces {v['z_interfaces_m']} m, eps ({eps}), {v['polarization']}"
+    if isinstance(v, list) and len(v) > 6:
+        return f"{len(v)} planes {v[0]:g}..{v[-1]:g}"
+    return repr(v) if isinstance(v, str) else str(v)

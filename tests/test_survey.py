@@ -1,0 +1,315 @@
+"""Surveys on Dask: many frames imaged with the same settings into one Zarr store.
+
+Exactness: a frame's stored image must be bit for bit ``migrate(frame, ...)`` in
+one process. The same float operations run in the same order on the same data
+wherever the task runs (FFT threads split a batch of transforms, never one
+transform), and I/Q are split and joined without arithmetic (the real and
+imaginary parts are copied), so the tolerance is 0, not a rounding bound.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from holoradar.survey import store as survey_store
+from holoradar.survey import worker as survey_worker
+
+F0 = 9.9e9
+PITCH = 0.01          # < lambda/2 = 1.51 cm at 9.9 GHz: no aliasing warning
+Z = [0.05, 0.1]       # two planes
+N_CLUSTER = 200
+
+
+def _frames(folder: Path, n: int, size: int = 8, seed: int = 0) -> tuple[list[Path], list]:
+    """``n`` random frames of size x size, placed along x every half aperture."""
+    rng = np.random.default_rng(seed)
+    x = (np.arange(size) - (size - 1) / 2) * PITCH
+    folder.mkdir(parents=True, exist_ok=True)
+    paths, holos = [], []
+    for i in range(n):
+        data = rng.standard_normal((size, size)) + 1j * rng.standard_normal((size, size))
+        h = hr.Hologram(data, x, x, F0, pose=hr.Pose((0.04 * i, 0.01 * (i % 3), 0.0)))
+        paths.append(hr.save(h, folder / f"frame{i:03d}.nc"))
+        holos.append(h)
+    return paths, holos
+
+
+@pytest.fixture(scope="module")
+def survey200(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[Path], list]:
+    return _frames(tmp_path_factory.mktemp("frames"), N_CLUSTER)
+
+
+def _stored(store: Path) -> dict:
+    idx = survey_store.read_index(store)
+    return {"idx": idx, "images": survey_store.read_images(idx, range(idx["n"]))}
+
+
+def _assert_exact(store: Path, paths: list[Path], holos: list, **kw) -> np.ndarray:
+    """Every frame marked done equals the single-process migrate bit for bit; the done mask."""
+    s = _stored(store)
+    idx = s["idx"]
+    by_path = {str(p.resolve()): h for p, h in zip(paths, holos, strict=True)}
+    for i in np.nonzero(idx["done"])[0]:
+        h = by_path[idx["frame_path"][i]]
+        ref = hr.migrate(h, Z, **kw).data
+        assert np.array_equal(s["images"][i], ref), f"frame {idx['frame_name'][i]} differs"
+        assert idx["frame_x"][i] == h.pose.center[0] and idx["frame_y"][i] == h.pose.center[1]
+    return idx["done"]
+
+
+# (a) a dask.distributed cluster of 2 worker processes gives the single-process results
+def test_cluster_of_two_workers_equals_single_process(survey200, tmp_path: Path) -> None:
+    from distributed import LocalCluster
+
+    paths, holos = survey200
+    # The files hold the holograms bit for bit (so migrating the ones in memory is the
+    # single-process result of each file); checked on a few.
+    for i in (0, 99, 199):
+        assert np.array_equal(hr.load(paths[i]).data, holos[i].data)
+    store = tmp_path / "survey.zarr"
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster:
+        summary = hr.survey.run_batch(paths, store, z=Z, scheduler=cluster.scheduler_address)
+    assert summary["done"] == N_CLUSTER and summary["skipped"] == [] and summary["resumed"] == 0
+    assert summary["workers"] == 2
+    done = _assert_exact(store, paths, holos)
+    assert done.all() and done.size == N_CLUSTER
+    ds = hr.survey.open_survey(store)
+    assert dict(ds["image"].sizes) == {"frame": N_CLUSTER, "z": 2, "y": 8, "x": 8, "iq": 2}
+    assert list(ds["frame_name"].values[:2]) == ["frame000.nc", "frame001.nc"]
+
+
+# (b) corrupt, truncated, empty and foreign frames: reported by name and skipped; strict stops
+def test_bad_frames_are_reported_and_skipped(survey200, tmp_path: Path) -> None:
+    paths, holos = survey200
+    good = paths[:4]
+    truncated = tmp_path / "truncated.nc"
+    truncated.write_bytes(paths[4].read_bytes()[: paths[4].stat().st_size // 2])
+    empty = tmp_path / "empty.nc"
+    empty.write_bytes(b"")
+    other = _frames(tmp_path / "big", 1, size=10)[0][0]  # another grid
+    image = hr.save(hr.migrate(holos[5], Z), tmp_path / "image.nc")
+    frames = [good[0], truncated, good[1], empty, good[2], other, image, good[3]]
+    s = hr.survey.run_batch(frames, tmp_path / "s.zarr", z=Z, scheduler="synchronous")
+    reasons = {Path(k["name"]).name: k["reason"] for k in s["skipped"]}
+    assert s["done"] == 4 and set(reasons) == {"truncated.nc", "empty.nc", "frame000.nc",
+                                               "image.nc"}
+    assert "is empty" in reasons["empty.nc"]
+    assert "not a readable NetCDF-4" in reasons["truncated.nc"] \
+        or "truncated" in reasons["truncated.nc"]
+    assert "10 x 10" in reasons["frame000.nc"] and "Image" in reasons["image.nc"]
+    assert _assert_exact(tmp_path / "s.zarr", paths, holos).sum() == 4
+
+    # strict: an empty file is seen before anything is written ...
+    with pytest.raises(ValueError, match=r"empty\.nc"):
+        hr.survey.run_batch([good[0], empty], tmp_path / "s1.zarr", z=Z, strict=True,
+                            scheduler="synchronous")
+    assert not (tmp_path / "s1.zarr").exists()
+    # ... a truncated one when it is read: the run stops there; what the store holds is
+    # complete (Dask may have run other frames first, in any order).
+    with pytest.raises(ValueError, match=r"truncated\.nc"):
+        hr.survey.run_batch([good[0], good[1], truncated, good[2]], tmp_path / "s2.zarr",
+                            z=Z, strict=True, scheduler="synchronous")
+    done = _assert_exact(tmp_path / "s2.zarr", paths, holos)
+    assert done.sum() <= 3 and not done[2]
+    # not strict, the same store finishes the rest
+    s = hr.survey.run_batch([good[0], good[1], truncated, good[2]], tmp_path / "s2.zarr",
+                            z=Z, scheduler="synchronous")
+    assert s["resumed"] + s["done"] == 3 and [k["name"] for k in s["skipped"]] == [
+        str(truncated)]
+
+
+# (c) a rerun resumes: frames already done are not imaged again
+def test_rerun_resumes_without_redoing(survey200, tmp_path: Path,
+                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    paths, holos = survey200
+    calls = []
+    real = survey_worker.migrate
+
+    def counting(*a, **kw):
+        calls.append(1)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(survey_worker, "migrate", counting)
+    store = tmp_path / "s.zarr"
+    s1 = hr.survey.run_batch(paths[:10], store, z=Z, scheduler="synchronous")
+    first = survey_store.read_index(store)["finished"].copy()
+    assert s1["done"] == 10 and len(calls) == 10
+    s2 = hr.survey.run_batch(paths[:20], store, z=Z, scheduler="synchronous")
+    assert (s2["done"], s2["resumed"], len(calls)) == (10, 10, 20)
+    idx = survey_store.read_index(store)
+    assert np.array_equal(idx["finished"][:10], first)     # untouched
+    assert np.all(idx["finished"][10:] >= first.max())
+    assert _assert_exact(store, paths, holos).sum() == 20
+    s3 = hr.survey.run_batch(paths[:20], store, z=Z, scheduler="synchronous")
+    assert (s3["done"], s3["resumed"], len(calls)) == (0, 20, 20)
+
+
+# (d) a run cut short leaves a readable store; the rerun completes it
+def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    paths, holos = survey200
+    frames = paths[:12]
+    real = survey_worker.write_frame
+    n = [0]
+    crashed = []
+
+    def crash_after_image(store, token, slot, data, position):
+        n[0] += 1
+        if n[0] <= 5:
+            return real(store, token, slot, data, position)
+        # The 6th frame: its image chunk is written, then the process "dies".
+        h = survey_store._handles(store, token)
+        h["image"][slot] = np.stack([data.real, data.imag], axis=-1)
+        crashed.append(slot)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(survey_worker, "write_frame", crash_after_image)
+    store = tmp_path / "s.zarr"
+    with pytest.raises(KeyboardInterrupt):
+        hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
+    ds = hr.survey.open_survey(store)
+    assert int(ds["done"].sum()) == 5 and not bool(ds["done"][crashed[0]])
+    assert _assert_exact(store, paths, holos).sum() == 5
+    monkeypatch.setattr(survey_worker, "write_frame", real)
+    s = hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
+    assert (s["resumed"], s["done"]) == (5, 7)
+    assert _assert_exact(store, paths, holos).all()
+
+
+def test_killed_process_leaves_readable_store(survey200, tmp_path: Path) -> None:
+    paths, holos = survey200
+    frames = paths[:120]
+    store = tmp_path / "s.zarr"
+    listing = tmp_path / "frames.txt"
+    listing.write_text("\n".join(map(str, frames)))
+    code = textwrap.dedent(f"""
+        import holoradar as hr
+        frames = open({str(listing)!r}).read().split()
+        hr.survey.run_batch(frames, {str(store)!r}, z={Z!r}, scheduler="synchronous")
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code])
+    try:
+        deadline = time.monotonic() + 60
+        k = 0
+        while time.monotonic() < deadline and proc.poll() is None:
+            if survey_store.is_survey(store):
+                k = int(survey_store.read_index(store)["done"].sum())
+                if k >= 5:
+                    break
+            time.sleep(0.01)
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
+    ds = hr.survey.open_survey(store)                    # readable
+    done_before = int(ds["done"].sum())
+    assert 5 <= done_before < len(frames)
+    assert _assert_exact(store, paths, holos).sum() == done_before
+    s = hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
+    assert (s["resumed"], s["done"]) == (done_before, len(frames) - done_before)
+    assert _assert_exact(store, paths, holos).all()
+
+
+# (e) the mosaic puts a point target at its world position
+def test_mosaic_places_a_point_target(tmp_path: Path) -> None:
+    target = (0.031, -0.018, 0.30)
+    scene = hr.Scene(targets=[hr.PointTarget(target)], source=hr.PlaneWave())
+    paths = []
+    for j, cy in enumerate((-0.1, 0.0, 0.1)):
+        for i, cx in enumerate((-0.1, 0.0, 0.1)):   # 16 x 16 frames, 16 cm wide: 6 cm overlap
+            ap = hr.Aperture.grid(16, PITCH, pose=hr.Pose((cx, cy, 0.0)))
+            paths.append(hr.save(hr.simulate(scene, ap, F0), tmp_path / f"t{j}{i}.nc"))
+    store = tmp_path / "scene.zarr"
+    s = hr.survey.run_batch(paths, store, z=[0.25, 0.30, 0.35], upsample=4,
+                            scheduler="synchronous")
+    assert s["done"] == 9
+    m = hr.survey.mosaic(store, 0.31)
+    px = PITCH / 4
+    assert float(m.z[0]) == 0.30 and m.data.shape == (141, 141)
+    assert np.isclose(m.x[0], -0.175) and np.isclose(m.x[-1], 0.175)
+    assert np.allclose(np.diff(m.x), px) and np.allclose(np.diff(m.y), px)
+    # The image of a point peaks on it: for the frame above it exactly (symmetric PSF,
+    # lambda*z/A ~ 6 cm wide); the frames beside it see it through a truncated aperture,
+    # which pulls their maximum by a fraction of that width, but the taper weights them
+    # down (measured 1 mm). Sampled every 2.5 mm (upsample=4, exact band-limited
+    # interpolation), the brightest pixel is within half a pixel of the peak: one pixel
+    # bounds both.
+    x, y, _ = m.peak()
+    assert abs(x - target[0]) <= px and abs(y - target[1]) <= px
+    # A finer map resamples bilinearly, whose maxima lie on the frames' samples: the
+    # same bound, one 2.5 mm sample.
+    fine = hr.survey.mosaic(store, 0.30, pitch=0.001)
+    assert fine.data.shape == (351, 351)
+    xf, yf, _ = fine.peak()
+    assert abs(xf - target[0]) <= px and abs(yf - target[1]) <= px
+    # One frame alone: the map is that frame's |image| exactly (weights cancel; the grid
+    # goes through its pixels, so no interpolation); relative rounding ~1e-16.
+    one = tmp_path / "one.zarr"
+    hr.survey.run_batch(paths[4:5], one, z=[0.30], scheduler="synchronous")
+    ref = np.abs(hr.migrate(hr.load(paths[4]), [0.30]).data[0])
+    np.testing.assert_allclose(hr.survey.mosaic(one, 0.3).data, ref, rtol=1e-14, atol=0)
+    img = hr.survey.frame_image(one, "t11.nc")
+    assert np.allclose(img.x, (np.arange(16) - 7.5) * PITCH)
+
+
+# (f) refusals, before any work
+def test_refusals(survey200, tmp_path: Path) -> None:
+    paths, _ = survey200
+    frame_as_zarr = tmp_path / "frame.zarr"
+    shutil.copy(paths[0], frame_as_zarr)
+    with pytest.raises(ValueError, match="one of the inputs"):
+        hr.survey.run_batch([frame_as_zarr], frame_as_zarr, z=Z, scheduler="synchronous")
+    (tmp_path / "in.zarr").mkdir()
+    inside = shutil.copy(paths[0], tmp_path / "in.zarr" / "f.nc")
+    with pytest.raises(ValueError, match="holds the frame"):
+        hr.survey.run_batch([inside], tmp_path / "in.zarr", z=Z, overwrite=True)
+    with pytest.raises(ValueError, match=r"must end in \.zarr"):
+        hr.survey.run_batch(paths[:2], tmp_path / "s.nc", z=Z, scheduler="synchronous")
+    with pytest.raises(ValueError, match="does not exist"):
+        hr.survey.run_batch(paths[:2], tmp_path / "no" / "s.zarr", z=Z)
+    with pytest.raises(ValueError, match="scheduler"):
+        hr.survey.run_batch(paths[:2], tmp_path / "s.zarr", z=Z, scheduler="fast")
+    with pytest.raises(ValueError, match="no frames"):
+        hr.survey.run_batch([], tmp_path / "s.zarr", z=Z)
+    (tmp_path / "foreign.zarr").mkdir()
+    with pytest.raises(ValueError, match="not a holoradar survey store"):
+        hr.survey.run_batch(paths[:2], tmp_path / "foreign.zarr", z=Z, overwrite=True)
+    store = tmp_path / "s.zarr"
+    hr.survey.run_batch(paths[:2], store, z=Z, scheduler="synchronous")
+    with pytest.raises(ValueError, match=r"z: the store has \[0.05, 0.1\] m.*overwrite=True"):
+        hr.survey.run_batch(paths[:2], store, z=[0.05, 0.2], scheduler="synchronous")
+    sand = hr.Medium.half_space(0.08, 2.5 + 0.01j)
+    with pytest.raises(ValueError, match="medium: the store has free space"):
+        hr.survey.run_batch(paths[:2], store, z=Z, medium=sand, scheduler="synchronous")
+    with pytest.raises(ValueError, match="upsample"):
+        hr.survey.run_batch(paths[:2], store, z=Z, upsample=2, scheduler="synchronous")
+    s = hr.survey.run_batch(paths[:2], store, z=Z, medium=sand, overwrite=True,
+                            scheduler="synchronous")
+    assert (s["done"], s["resumed"]) == (2, 0)
+    assert hr.survey.open_survey(store).attrs["settings"]["medium"]["eps"][1] == [2.5, 0.01]
+    with pytest.raises(ValueError, match="not a holoradar survey store"):
+        hr.survey.open_survey(tmp_path / "foreign.zarr")
+    with pytest.raises(ValueError, match=r"none of the 1 frames can be imaged.*is not a file"):
+        hr.survey.run_batch([tmp_path / "x.nc"], tmp_path / "t.zarr", z=Z)
+    assert not (tmp_path / "t.zarr").exists()
+
+
+def test_default_local_scheduler_processes(survey200, tmp_path: Path) -> None:
+    paths, holos = survey200
+    s = hr.survey.run_batch(paths[:16], tmp_path / "s.zarr", z=Z)
+    assert s["scheduler"] == "processes" and s["done"] == 16
+    assert _assert_exact(tmp_path / "s.zarr", paths, holos).all()
+    s = hr.survey.run_batch(paths[:16], tmp_path / "t.zarr", z=Z, scheduler="threads")
+    assert s["done"] == 16 and _assert_exact(tmp_path / "t.zarr", paths, holos).all()
