@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import holoradar as hr
-from holoradar.io.netcdf import source_to_json, to_dataset
+from holoradar.io.netcdf import from_dataset, read_direct, source_to_json, to_dataset
 
 F0 = 9.9e9
 X = (np.arange(5) - 2) * 0.0125
@@ -66,6 +66,12 @@ def test_save_then_load_gives_back_an_equal_object(name, tmp_path):
     obj = HOLOGRAMS.get(name, IMAGES.get(name))
     path = hr.save(obj, tmp_path / "out.nc")
     _same(obj, hr.load(path))
+    # Both readers, the direct h5py one (used first: fast) and xarray's, give it back.
+    import xarray as xr
+
+    _same(obj, read_direct(path))
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        _same(obj, from_dataset(ds.load()))
 
 
 def test_file_is_plain_netcdf_with_cf_units(tmp_path):

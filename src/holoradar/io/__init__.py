@@ -22,7 +22,7 @@ import numpy as np
 from ..data.hologram import Hologram, Image
 from ..data.plausibility import check_plausible
 from .layout import Layout, assemble
-from .netcdf import from_dataset, read_history, to_dataset
+from .netcdf import from_dataset, read_direct, read_history, to_dataset
 from .output import check_output, write_via_temp
 from .readers import read_variables
 
@@ -196,6 +196,10 @@ def _load_netcdf(src: Path) -> Hologram | Image:
         raise ValueError(f"path {str(src)!r} is not a file")
     if src.stat().st_size == 0:
         raise ValueError(f"path {str(src)!r} is empty")
+    try:
+        return read_direct(src)
+    except Exception:  # anything odd: the xarray path below names the problem
+        pass
     try:
         with xr.open_dataset(src, engine="h5netcdf") as ds:
             ds.load()

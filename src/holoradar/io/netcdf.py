@@ -226,6 +226,60 @@ def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
     return Image(data, x, y, z, freq, str(ds.attrs.get("method", "angular")), has_z_axis=has_z)
 
 
+class _Variable:
+    """The little of an xarray variable that :func:`from_dataset` uses."""
+
+    def __init__(self, dims: tuple[str, ...], values: np.ndarray) -> None:
+        self.dims, self.values, self.shape = dims, values, values.shape
+
+
+class _H5View:
+    """A holoradar file read with h5py directly: the attributes, and each variable's
+    dimension names (from its NetCDF-4 dimension list) and values."""
+
+    def __init__(self, f: Any) -> None:
+        self.attrs = {k: _attr(v) for k, v in f.attrs.items() if not k.startswith("_")}
+        self.variables: dict[str, _Variable] = {}
+        for name, ds in f.items():
+            refs = ds.attrs.get("DIMENSION_LIST")
+            if refs is None:
+                dims = (name,) if ds.ndim == 1 else ()
+            else:
+                dims = tuple(f[r[0]].name.lstrip("/") for r in refs)
+            if len(dims) != ds.ndim:
+                raise KeyError(name)
+            values = ds[()]
+            if values.dtype.kind in "SO":  # NetCDF strings (the iq labels)
+                values = values.astype(str)
+            self.variables[name] = _Variable(dims, np.asarray(values))
+
+    def __getitem__(self, name: str) -> _Variable:
+        return self.variables[name]
+
+
+def _attr(v: Any) -> Any:
+    if isinstance(v, bytes | np.bytes_):
+        return v.decode("utf-8", "replace")
+    if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "biuf":
+        return v.reshape(()).item()
+    return v
+
+
+def read_direct(path: str | os.PathLike[str]) -> Hologram | Image:
+    """Read a holoradar file with h5py, without xarray: the same object as
+    ``from_dataset(xarray.open_dataset(path))`` in a tenth of the time (what a
+    survey of small frames spends most of its time on).
+
+    Raises ``KeyError``/``OSError``/``ValueError`` on anything unexpected; the caller
+    then takes the xarray path, whose messages explain the problem.
+    """
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        view = _H5View(f)
+    return from_dataset(view, what=str(path))
+
+
 def read_history(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """The processing history stored in a holoradar NetCDF file (a list of steps)."""
     import xarray as xr
