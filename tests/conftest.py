@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -18,3 +19,14 @@ def rng() -> np.random.Generator:
 
 def crandn(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
     return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+
+FUZZED: Counter[str] = Counter()
+"""Inputs tried by each property-based (fuzzing) test, reported at the end of the run."""
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    if FUZZED:
+        terminalreporter.write_sep("-", "fuzzing: inputs tried")
+        for name, n in sorted(FUZZED.items()):
+            terminalreporter.write_line(f"{n:6d}  {name}")

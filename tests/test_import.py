@@ -17,6 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import holoradar as hr
+from conftest import FUZZED
 from holoradar.io.layout import Layout
 
 DATA = Path(__file__).parent / "data"
@@ -252,7 +253,6 @@ def _seed_files(tmp: Path) -> dict[str, bytes]:
     return _SEEDS
 
 
-FUZZ_COUNT = {"n": 0}
 
 
 @settings(max_examples=int(os.environ.get("HOLORADAR_FUZZ_EXAMPLES", "150")), deadline=None,
@@ -279,7 +279,7 @@ def test_fuzzed_files_give_a_clear_error_or_a_valid_hologram(tmp_path, name, op,
     path.write_bytes(bytes(blob))
     before = path.read_bytes()
     listing = sorted(tmp_path.iterdir())
-    FUZZ_COUNT["n"] += 1
+    FUZZED["readers: damaged npz/npy/mat/mat7.3/h5/csv files"] += 1
     layout = Layout(pitch=0.025, frequency=F) if name == "s.npy" else None
     try:
         h = hr.load(path, layout=layout)
@@ -294,6 +294,7 @@ def test_fuzzed_files_give_a_clear_error_or_a_valid_hologram(tmp_path, name, op,
 @settings(max_examples=100, deadline=None)
 @given(text=st.text(max_size=80))
 def test_fuzzed_layout_text_gives_a_clear_error(text):
+    FUZZED["layout text"] += 1
     try:
         Layout.parse(text)
     except ValueError as exc:

@@ -10,6 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import holoradar as hr
+from conftest import FUZZED
 from holoradar.io.netcdf import from_dataset, read_direct, source_to_json, to_dataset
 
 F0 = 9.9e9
@@ -169,6 +170,7 @@ def test_fuzzed_files_fail_cleanly_and_stay_untouched(tmp_path, data):
         hr.save(HOLOGRAMS["wideband"], base)
     raw = base.read_bytes()
     kind = data.draw(st.sampled_from(["truncate", "flip", "attrs"]))
+    FUZZED["holoradar NetCDF files: truncated, bit-flipped, attributes mangled"] += 1
     path = tmp_path / "fuzz.nc"
     if kind == "truncate":
         path.write_bytes(raw[: data.draw(st.integers(0, len(raw) - 1))])

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import holoradar as hr
+from conftest import FUZZED
 from holoradar.model.scene_file import load_scene, scene_from_mapping
 
 VALID = {
@@ -48,7 +49,6 @@ _keys = {
     "target": ["type", "position", "amplitude", "shape", "z", "diameter", "width"],
     "simulate": ["include_surface", "snr_db", "seed", "include_direct"],
 }
-TRIED = {"n": 0}
 
 
 @st.composite
@@ -78,7 +78,7 @@ def documents(draw):
 @settings(max_examples=300, deadline=None)
 @given(doc=documents())
 def test_fuzzed_scenes_build_or_name_the_key(doc):
-    TRIED["n"] += 1
+    FUZZED["scene parser: mutated scene documents"] += 1
     try:
         spec = scene_from_mapping(doc)
     except ValueError as exc:
@@ -90,6 +90,7 @@ def test_fuzzed_scenes_build_or_name_the_key(doc):
 @settings(max_examples=200, deadline=None)
 @given(text=st.text(max_size=200))
 def test_fuzzed_toml_text_gives_one_clear_error(tmp_path_factory, text):
+    FUZZED["scene parser: arbitrary TOML text"] += 1
     p = tmp_path_factory.mktemp("toml") / "s.toml"
     p.write_text(text, encoding="utf-8")
     with pytest.raises(ValueError):

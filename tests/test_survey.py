@@ -20,8 +20,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import holoradar as hr
+from conftest import FUZZED
 from holoradar.survey import store as survey_store
 from holoradar.survey import worker as survey_worker
 
@@ -313,3 +316,42 @@ def test_default_local_scheduler_processes(survey200, tmp_path: Path) -> None:
     assert _assert_exact(tmp_path / "s.zarr", paths, holos).all()
     s = hr.survey.run_batch(paths[:16], tmp_path / "t.zarr", z=Z, scheduler="threads")
     assert s["done"] == 16 and _assert_exact(tmp_path / "t.zarr", paths, holos).all()
+
+
+_DAMAGED = {"n": 0}
+
+
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_damaged_stores_give_a_clear_error(survey200, tmp_path: Path, data) -> None:
+    """A store whose files were truncated, flipped or removed: reading it (open_survey,
+    mosaic, frame_image) is a ValueError or a valid answer, never another exception."""
+    paths, _ = survey200
+    base = tmp_path / "base.zarr"
+    if not base.exists():
+        hr.survey.run_batch(paths[:3], base, z=0.3, scheduler="synchronous")
+    store = tmp_path / f"s{_DAMAGED['n']}.zarr"
+    _DAMAGED["n"] += 1
+    FUZZED["survey stores: a file truncated, flipped or removed"] += 1
+    shutil.copytree(base, store)
+    files = sorted(p for p in store.rglob("*") if p.is_file())
+    victim = data.draw(st.sampled_from(files))
+    op = data.draw(st.sampled_from(["truncate", "flip", "remove"]))
+    blob = bytearray(victim.read_bytes())
+    if op == "remove":
+        victim.unlink()
+    elif op == "truncate":
+        victim.write_bytes(bytes(blob[: data.draw(st.integers(0, max(0, len(blob) - 1)))]))
+    elif blob:
+        at = data.draw(st.integers(0, len(blob) - 1))
+        blob[at] ^= 1 << data.draw(st.integers(0, 7))
+        victim.write_bytes(bytes(blob))
+    for read in (lambda: hr.survey.open_survey(store).load(),
+                 lambda: hr.survey.mosaic(store, 0.3),
+                 lambda: hr.survey.frame_image(store, 0)):
+        try:
+            read()
+        except ValueError as exc:
+            assert str(exc)

@@ -25,12 +25,13 @@ into place: it exists complete or not at all.
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import tempfile
 import time
 import uuid
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -159,6 +160,26 @@ def _dir_mode() -> int:
     return 0o777 & ~mask
 
 
+def _damaged_as_value_error(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """A store whose files were damaged (truncated, bit-flipped, removed) makes zarr and
+    its codecs raise many kinds of errors: turn them into one ValueError naming the store."""
+
+    @functools.wraps(fn)
+    def wrapper(target: Any, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(target, *args, **kwargs)
+        except ValueError:
+            raise
+        except Exception as exc:  # zarr, numcodecs and the file system fail in many ways
+            where = target if isinstance(target, str | os.PathLike) else \
+                target.get("path", "the survey") if isinstance(target, dict) else "the survey"
+            raise ValueError(f"store {str(where)!r} is damaged or unreadable "
+                             f"({type(exc).__name__}: {exc})") from None
+
+    return wrapper
+
+
+@_damaged_as_value_error
 def stored_settings(target: Path) -> tuple[Settings, FrameGeometry]:
     """The settings and geometry a store was made with."""
     import zarr
@@ -168,6 +189,7 @@ def stored_settings(target: Path) -> tuple[Settings, FrameGeometry]:
         FrameGeometry.from_dict(dict(attrs["geometry"]))
 
 
+@_damaged_as_value_error
 def register_frames(target: Path, paths: Sequence[Path]) -> list[int]:
     """The slot of every frame (absolute paths), adding slots for new ones.
 
@@ -242,6 +264,7 @@ def write_frame(store: str, token: str, slot: int, data: np.ndarray,
     h["done"][slot] = True  # last: done means complete
 
 
+@_damaged_as_value_error
 def read_index(target: Path) -> dict[str, Any]:
     """The small arrays of a store (per frame and coordinates) and its attributes.
 
@@ -255,7 +278,7 @@ def read_index(target: Path) -> dict[str, Any]:
                          f"'holoradar_survey' = {LAYOUT!r} attribute in a Zarr group)")
     g = zarr.open_group(str(target), mode="r")
     n = min(g[a].shape[0] for a in FRAME_ARRAYS)
-    out: dict[str, Any] = {"n": n, "group": g, "attrs": dict(g.attrs)}
+    out: dict[str, Any] = {"n": n, "group": g, "attrs": dict(g.attrs), "path": str(target)}
     for a in (*_PER_FRAME, *_NAMES):
         out[a] = np.asarray(g[a][:n])
     for a in ("z", "y", "x"):
@@ -268,6 +291,7 @@ def read_index(target: Path) -> dict[str, Any]:
     return out
 
 
+@_damaged_as_value_error
 def read_images(index: dict[str, Any], frames: Sequence[int],
                 plane: int | None = None) -> np.ndarray:
     """Complex images of ``frames`` (k, nz, ny', nx'), or of one ``plane`` (k, ny', nx')."""
