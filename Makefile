@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	@touch $(STAMP)
 
 demo: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/holoradar demo --out demo_out
+	MPLBACKEND=Agg $(BIN)/holoradar demo --out demo_out --force
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples

@@ -310,3 +310,68 @@ def test_npz_member_declaring_more_than_it_holds_is_refused(tmp_path):
         z.writestr("data.npy", b.getvalue() + b"\0" * 1024)
     with pytest.raises(ValueError, match=r"holds only"):
         hr.load(p, layout="frequency=9.9e9, pitch=0.025")
+
+
+def test_matlab_and_hdf5_parse_in_a_separate_process_that_survives_crashes(tmp_path):
+    """The C parsers run in a kept parser process: a script without a main guard is not
+    run again, and a parser process that dies is replaced on the next file."""
+    import subprocess
+    import sys
+
+    from holoradar.io import readers
+
+    script = tmp_path / "noguard.py"
+    script.write_text(
+        "import numpy as np, scipy.io, holoradar as hr\n"
+        "print('top level ran')\n"
+        f"p = {str(tmp_path / 'g.mat')!r}\n"
+        "x = np.arange(4) * 0.01\n"
+        "scipy.io.savemat(p, {'data': np.ones((4, 4)) + 1j, 'x': x, 'y': x, "
+        "'frequency': 9.9e9})\n"
+        "print(hr.load(p).data.shape)\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("top level ran") == 1 and "(4, 4)" in done.stdout
+    scipy.io.savemat(tmp_path / "a.mat", {"data": FIELD, "x": X, "y": Y, "frequency": F})
+    _same(hr.load(tmp_path / "a.mat"))
+    readers._PARSER.proc.kill()  # as if a parser had crashed
+    readers._PARSER.proc.wait()
+    _same(hr.load(tmp_path / "a.mat"))
+    # variables named like numpy's own arguments come through
+    with h5py.File(tmp_path / "n.h5", "w") as f:
+        f["file"], f["allow_pickle"] = np.arange(3.0), np.ones(2)
+    got = readers.read_variables(tmp_path / "n.h5")
+    assert np.array_equal(got["file"], np.arange(3.0)) and got["allow_pickle"].size == 2
+
+
+def test_foreign_netcdf_is_cf_decoded_and_netcdf3_read(tmp_path):
+    """A NetCDF file from another program is read as NetCDF tools show it: packed
+    integers scaled back, NetCDF-3 classic files too."""
+    import xarray as xr
+
+    scale = 1e-4
+    packed = xr.Dataset({"I": (("y", "x"), np.round(FIELD.real / scale).astype(np.int16)),
+                         "Q": (("y", "x"), np.round(FIELD.imag / scale).astype(np.int16))},
+                        coords={"x": X, "y": Y})
+    for v in ("I", "Q"):
+        packed[v].attrs.update(scale_factor=scale, add_offset=0.0)
+    packed.attrs["frequency"] = F
+    packed.to_netcdf(tmp_path / "packed.nc", engine="h5netcdf")
+    h = hr.load(tmp_path / "packed.nc", layout="frequency=@frequency")
+    # int16 packing rounds to half a step: |error| <= scale/2 on each of I and Q.
+    assert np.max(np.abs(h.data.real - FIELD.real)) <= scale / 2 + 1e-12
+    assert np.max(np.abs(h.data.imag - FIELD.imag)) <= scale / 2 + 1e-12
+    classic = xr.Dataset({"I": (("y", "x"), FIELD.real), "Q": (("y", "x"), FIELD.imag)},
+                         coords={"x": X, "y": Y}, attrs={"frequency": F})
+    classic.to_netcdf(tmp_path / "classic.nc", engine="scipy")
+    _same(hr.load(tmp_path / "classic.nc", layout="frequency=@frequency"))
+
+
+def test_hdf5_external_storage_is_not_followed(tmp_path):
+    secret = tmp_path / "secret.bin"
+    secret.write_bytes(np.arange(8.0).tobytes())
+    with h5py.File(tmp_path / "ext.h5", "w") as f:
+        f.create_dataset("data", shape=(8,), dtype="<f8", external=[(str(secret), 0, 64)])
+    got = hr.io.read_variables(tmp_path / "ext.h5")
+    assert "data" not in got and "not read" in " ".join(map(str, got["__other__"]))

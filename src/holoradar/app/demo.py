@@ -26,7 +26,14 @@ from .presets import lab_stand
 __all__ = ["run_demo"]
 
 
-def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[str, Any]:
+FILES = ("hologram.png", "image_object_range.png",
+         "depth_sweep.png", "glare_mirror_plane.png", "spectrum_window.png", "hologram.nc",
+         "summary.json")
+"""What the demo writes into its folder."""
+
+
+def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
+             overwrite: bool = False) -> dict[str, Any]:
     """Simulate the lab stand, migrate it and (if ``out``) write figures and summary.json.
 
     Parameters
@@ -35,6 +42,9 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         Output folder (created if missing). ``None`` computes without writing.
     upsample : int
         Image pixels per element pitch.
+    overwrite : bool
+        Replace the demo's files in ``out`` if they exist (default: refuse, before
+        any work, naming the first one found).
 
     Returns
     -------
@@ -47,6 +57,11 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
     >>> round(s["theory"]["apparent_distance_m"], 4)
     0.3759
     """
+    if out is not None and not overwrite:
+        there = [n for n in FILES if (Path(out) / n).exists()]
+        if there:
+            raise ValueError(f"{Path(out) / there[0]} exists (and {len(there) - 1} more of the "
+                             "demo's files): pass --force (overwrite=True) to replace them")
     t0 = time.perf_counter()
     stand = lab_stand()
     scene, ap, f = stand.scene, stand.aperture, stand.frequency
@@ -154,12 +169,12 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8) -> dict[
         outdir.mkdir(parents=True, exist_ok=True)
         for name, payload in pngs.items():
             write_atomic(outdir / name, payload)
-        # The hologram too, so that `holoradar image demo_out/hologram.nc ...` works; the
-        # demo's folder is its own: a rerun replaces what it wrote there.
+        # The hologram too, so that `holoradar image demo_out/hologram.nc ...` works.
         from ..io import save
 
         save(holo, outdir / "hologram.nc", overwrite=True,
              history=[{"step": "simulate", "parameters": {"scene": "demo: letter R in sand"}}])
         summary["files"] = sorted([*pngs, "hologram.nc", "summary.json"])
+        assert set(summary["files"]) == set(FILES), "FILES lists what the demo writes"
         write_atomic(outdir / "summary.json", json.dumps(summary, indent=2).encode())
     return summary

@@ -134,11 +134,26 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
         if sidecar.is_file():
             extra, side_layout = read_sidecar(sidecar)
             variables = {**extra, **variables}  # the file's own arrays win
-        full = (side_layout or Layout()).merged(lay)
-        obj = assemble(variables, full, what=src.name)
+        kind = variables.get("holoradar_kind")
+        if kind is not None and kind.dtype.kind == "U" and str(kind) == "Image":
+            obj = _npz_image(variables, src.name)
+        else:
+            full = (side_layout or Layout()).merged(lay)
+            obj = assemble(variables, full, what=src.name)
     if check and isinstance(obj, Hologram):
         check_plausible(obj, what=src.name)
     return obj
+
+
+def _npz_image(v: dict[str, np.ndarray], what: str) -> Image:
+    """An image that ``holoradar image --out img.npz`` wrote."""
+    missing = [k for k in ("data", "x", "y", "z", "frequency") if k not in v]
+    if missing:
+        raise ValueError(f"{what}: an image file lacks {missing}")
+    f = v["frequency"]
+    return Image(v["data"], v["x"], v["y"], np.atleast_1d(v["z"]),
+                 float(f) if f.ndim == 0 else f, str(v.get("method", "angular")),
+                 has_z_axis=bool(v.get("has_z_axis", np.array(True))))
 
 
 def _as_layout(layout: Any) -> Layout | None:
@@ -153,13 +168,15 @@ def _as_layout(layout: Any) -> Layout | None:
 
 
 def _is_holoradar_netcdf(src: Path) -> bool:
+    """Whether a file is a holoradar NetCDF file (False for one h5py cannot open: the
+    generic reader then reads a NetCDF-3 file or names the damage)."""
     import h5py
 
     try:
         with h5py.File(src, "r") as f:
             return "holoradar_kind" in f.attrs
-    except Exception:  # not HDF5 at all: let the NetCDF reader name the problem
-        return True
+    except Exception:  # not HDF5 (a NetCDF-3 file, or damaged)
+        return False
 
 
 def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:

@@ -24,9 +24,11 @@ Formats
 
 from __future__ import annotations
 
+import atexit
 import csv
-import functools
 import io
+import json
+import threading
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -168,6 +170,7 @@ def _read_hdf5(path: Path, *, matlab: bool = False) -> dict[str, np.ndarray]:
 
     out: dict[str, np.ndarray] = {}
     other: list[str] = []
+    total = [0]
 
     def visit(name: str, obj: Any) -> None:
         if isinstance(obj, h5py.Dataset):
@@ -180,6 +183,14 @@ def _read_hdf5(path: Path, *, matlab: bool = False) -> dict[str, np.ndarray]:
             if dtype.kind not in "biufc" and not (dtype.names and _compound_ok(dtype)):
                 other.append(name)
                 return
+            if obj.external or obj.is_virtual:
+                # data kept in other files: never followed (a crafted file could point
+                # at any file the user can read)
+                other.append(f"{name} (stored in other files: not read)")
+                return
+            total[0] += obj.size * dtype.itemsize
+            _check_size((total[0],), np.dtype(np.uint8), MAX_ARRAY_BYTES,
+                        f"{path.name} in all")
             _check_size(tuple(obj.shape), dtype, MAX_ARRAY_BYTES, f"dataset {name!r} in "
                         f"{path.name}")
             arr = obj[()]
@@ -280,8 +291,36 @@ def _is_number(text: str) -> bool:
 
 
 def read_netcdf_variables(path: Path) -> dict[str, np.ndarray]:
-    """A NetCDF file not written by holoradar: every numeric variable by name."""
-    return _read_hdf5(path)
+    """A NetCDF file not written by holoradar (NetCDF-4 or NetCDF-3): every numeric
+    variable by name, CF-decoded (``scale_factor``, ``add_offset``, ``_FillValue`` applied,
+    as any NetCDF tool shows them), numeric global attributes as ``@name``."""
+    import xarray as xr
+
+    out: dict[str, np.ndarray] = {}
+    other: list[str] = []
+    total = 0
+    try:
+        ds = xr.open_dataset(path, decode_times=False, decode_timedelta=False)
+    except (ValueError, OSError, TypeError, KeyError) as exc:
+        raise ValueError(f"{path.name} is not a readable NetCDF file "
+                         f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+    with ds:
+        for name, var in ds.variables.items():
+            if var.dtype.kind not in "biufc":
+                other.append(str(name))
+                continue
+            _check_size(tuple(var.shape), var.dtype, MAX_ARRAY_BYTES,
+                        f"variable {name!r} in {path.name}")
+            total += var.size * var.dtype.itemsize
+            _check_size((total,), np.dtype(np.uint8), MAX_ARRAY_BYTES, f"{path.name} in all")
+            out[str(name)] = np.array(var.values)
+        for key, v in ds.attrs.items():
+            a = np.asarray(v)
+            if a.dtype.kind in "biufc" and a.size <= 1_000_000:
+                out[f"@{key}"] = a
+    if other:
+        out["__other__"] = np.array(other)
+    return out
 
 
 READERS = {
@@ -298,57 +337,76 @@ READERS = {
 
 # Parsers written in C (scipy's MATLAB reader, the HDF5 library) can crash the whole
 # interpreter on a damaged file (seen when fuzzing: a segmentation fault in loadmat).
-# They run in a child process; its arrays come back as an .npz byte string read by the
-# pure-Python reader above, so a crash becomes a clear error and nothing is unpickled.
+# They run in a separate Python process (``python -m holoradar.io._parse_server``,
+# started once and kept): its arrays come back as .npz bytes read by the pure-Python
+# reader above, so a crash is one clear error and nothing is unpickled. A plain
+# subprocess, not multiprocessing: it does not import the caller's script again and it
+# works inside daemon processes (Dask workers).
 _ISOLATED = {read_mat, read_hdf5, read_netcdf_variables}
 
 
-def _child(reader_name: str, path: str, conn: Any) -> None:  # pragma: no cover - child
-    try:
-        variables = globals()[reader_name](Path(path))
-        buf = io.BytesIO()
-        np.savez(buf, **variables)
-        conn.send_bytes(b"K" + buf.getvalue())
-    except ValueError as exc:
-        conn.send_bytes(b"E" + str(exc).encode("utf-8", "replace"))
-    except Exception as exc:  # any parser failure becomes the file's error
-        conn.send_bytes(b"E" + f"{Path(path).name} is not a readable {Path(path).suffix} "
-                        f"file ({type(exc).__name__}: {exc})".encode("utf-8", "replace"))
-    finally:
-        conn.close()
+def pack(variables: dict[str, np.ndarray]) -> bytes:
+    """Arrays as the bytes of an ``.npz`` archive (any names; never pickled)."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as zf:
+        for name, arr in variables.items():
+            with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
+                np.lib.format.write_array(fh, np.asarray(arr), allow_pickle=False)
+    return buf.getvalue()
 
 
-@functools.cache
-def _context() -> Any:
-    import multiprocessing as mp
+class _ParserProcess:
+    """The parser process: one request at a time, restarted after a crash."""
 
-    # forkserver: children fork from a clean single-threaded server, so no lock held
-    # by one of the caller's threads (a Dask worker's, h5py's) is inherited; the server
-    # imports the parsers once, so a child starts in milliseconds.
-    if "forkserver" in mp.get_all_start_methods():
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["holoradar.io.readers", "scipy.io", "h5py"])
-        return ctx
-    return mp.get_context("spawn")
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.proc: Any = None
+
+    def _start(self) -> None:
+        import subprocess
+        import sys
+
+        self.proc = subprocess.Popen([sys.executable, "-m", "holoradar.io._parse_server"],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL)
+
+    def close(self) -> None:
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.stdin.close()
+            try:
+                self.proc.wait(timeout=2)
+            except Exception:  # it will be killed with the interpreter
+                self.proc.kill()
+        self.proc = None
+
+    def parse(self, reader: Any, path: Path) -> bytes:
+        request = (json.dumps([reader.__name__, str(path.resolve())]) + "\n").encode()
+        with self.lock:
+            if self.proc is None or self.proc.poll() is not None:
+                self._start()
+            try:
+                self.proc.stdin.write(request)
+                self.proc.stdin.flush()
+                head = self.proc.stdout.read(8)
+                blob = self.proc.stdout.read(int.from_bytes(head, "big")) \
+                    if len(head) == 8 else b""
+            except OSError:
+                blob = b""
+            if not blob:
+                code = self.proc.poll()
+                self.close()
+                raise ValueError(f"{path.name}: the {path.suffix} parser crashed on this file "
+                                 f"(exit code {code}): it is damaged or not a valid "
+                                 f"{path.suffix} file")
+        return blob
+
+
+_PARSER = _ParserProcess()
+atexit.register(_PARSER.close)
 
 
 def _isolated(reader: Any, path: Path) -> dict[str, np.ndarray]:
-    ctx = _context()
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(reader.__name__, str(path), send), daemon=True)
-    proc.start()
-    send.close()
-    try:
-        blob = recv.recv_bytes()
-    except EOFError:
-        blob = b""
-    finally:
-        recv.close()
-        proc.join()
-    if not blob:
-        raise ValueError(f"{path.name}: the {path.suffix} parser crashed on this file (exit "
-                         f"code {proc.exitcode}): it is damaged or not a valid {path.suffix} "
-                         "file")
+    blob = _PARSER.parse(reader, path)
     if blob[:1] == b"E":
         raise ValueError(blob[1:].decode("utf-8", "replace"))
     return read_npz_bytes(blob[1:], path.name)

@@ -119,6 +119,35 @@ class _Stack(NamedTuple):
     rho: list[np.ndarray]                            # reflection below interface j
 
 
+def check_ground_permittivity(eps: complex, name: str = "eps") -> complex:
+    """A ground permittivity a user gave: also refuse the likely slips.
+
+    No ground is optically thinner than air, and a negative real part is a metal
+    or a plasma, not soil: both are far likelier slips (a sign, a loss tangent
+    or a conductivity typed in the permittivity's place) than the intended
+    medium. Used by :meth:`Medium.half_space`, :meth:`Medium.layered` and the
+    scene and command-line parsers; the bare constructor ``Medium(...)`` (used
+    by fits that explore trial values) does not refuse them.
+
+    Examples
+    --------
+    >>> check_ground_permittivity(-2.5)
+    Traceback (most recent call last):
+    ...
+    ValueError: eps = (-2.5+0j) has a negative real part: a sign slip? holoradar's permittivities are eps' + i*eps'' with eps' >= 1 and loss as a positive imaginary part (e.g. sand 2.5+0.0125j)
+    """
+    e = _check_eps(eps, name)
+    if e.real < 0:
+        raise ValueError(f"{name} = {e} has a negative real part: a sign slip? holoradar's "
+                         "permittivities are eps' + i*eps'' with eps' >= 1 and loss as a "
+                         "positive imaginary part (e.g. sand 2.5+0.0125j)")
+    if e.real < 1:
+        raise ValueError(f"{name} = {e} has a real part below 1 (air): no soil, rock or "
+                         "concrete has one; was a loss tangent or a conductivity given in "
+                         "the permittivity's place? (e.g. sand 2.5+0.0125j)")
+    return e
+
+
 def _check_eps(eps: complex, name: str) -> complex:
     try:
         e = complex(eps)
@@ -131,17 +160,6 @@ def _check_eps(eps: complex, name: str) -> complex:
                          f"Im(eps) < 0 would be a medium with gain, got {e}")
     if e == 0:
         raise ValueError(f"{name} must be non-zero")
-    # No ground is optically thinner than air, and a negative real part is a metal or
-    # plasma, not soil: both are far likelier slips (a sign, a loss tangent or
-    # conductivity typed in the permittivity's place) than the intended medium.
-    if e.real < 0:
-        raise ValueError(f"{name} = {e} has a negative real part: a sign slip? holoradar's "
-                         "permittivities are eps' + i*eps'' with eps' >= 1 and loss as a "
-                         "positive imaginary part (e.g. sand 2.5+0.0125j)")
-    if e.real < 1:
-        raise ValueError(f"{name} = {e} has a real part below 1 (air): no soil, rock or "
-                         "concrete has one; was a loss tangent or a conductivity given in "
-                         "the permittivity's place? (e.g. sand 2.5+0.0125j)")
     return e
 
 
@@ -223,7 +241,7 @@ class Medium:
         except (TypeError, ValueError):
             raise ValueError(f"z_surface must be a range in metres > 0, got {z_surface!r}") \
                 from None
-        return cls((z,), (1.0, _check_eps(eps, "eps")), polarization)
+        return cls((z,), (1.0, check_ground_permittivity(eps, "eps")), polarization)
 
     @classmethod
     def layered(cls, z_interfaces: Sequence[float], eps: Sequence[complex], *,
@@ -248,6 +266,7 @@ class Medium:
         ep = tuple(np.atleast_1d(np.asarray(eps, dtype=complex)))
         if len(zi) != len(ep):
             raise ValueError(f"eps must have one value per interface ({len(zi)}), got {len(ep)}")
+        ep = tuple(check_ground_permittivity(e, f"eps[{j}]") for j, e in enumerate(ep))
         return cls(zi, (1.0, *ep), polarization)
 
     # --------------------------------------------------------------- properties

@@ -68,7 +68,8 @@ def main() -> None:
 
     Typical use: `holoradar info FILE` to see what a file holds, `holoradar
     image FILE --z 0.3:0.6:0.005 --eps 2.5 --z-surface 0.3 --out img.nc` to
-    image it, `holoradar plot img.nc --out img.png` to look at it.
+    image it (img.png beside it shows its brightest plane), `holoradar plot
+    img.nc --out planes.png --z 0.4 --z 0.45` to look at chosen planes.
     """
 
 

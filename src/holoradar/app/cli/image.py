@@ -36,7 +36,11 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
         save(img, out, overwrite=force, history=history)
     else:
         buf = io.BytesIO()
-        np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency)
+        # holoradar_kind marks it as an image, so that reading it never mistakes it for
+        # a hologram (plain numbers, no pickle)
+        np.savez(buf, data=img.data, x=img.x, y=img.y, z=img.z, frequency=img.frequency,
+                 holoradar_kind=np.array("Image"), method=np.array(img.method),
+                 has_z_axis=np.array(img.has_z_axis))
         write_atomic(out, buf.getvalue())
     files = [str(out)]
     if png:

@@ -60,12 +60,14 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
 
     summary: dict[str, Any] = {"file": str(file), "bytes": file.stat().st_size}
     lines = [f"{file.name} ({file.stat().st_size} bytes)"]
-    is_ours = file.suffix.lower() in (".nc", ".nc4")
+    from ...io import _is_holoradar_netcdf
+
+    is_ours = file.suffix.lower() in (".nc", ".nc4") and _is_holoradar_netcdf(file)
     obj, reason = None, None
     try:
         obj = load(file, layout=layout, check=False)
     except ValueError as exc:
-        if is_ours and "holoradar" not in str(exc) and layout is None:
+        if is_ours:  # a damaged holoradar file: its error is the answer
             raise
         reason = str(exc)
     if obj is None or not is_ours:

@@ -16,11 +16,12 @@ __all__ = ["COMMANDS"]
 @click.command()
 @click.option("--out", default="demo_out", show_default=True,
               type=click.Path(file_okay=False, path_type=Path),
-              help="Output folder (the demo's own: its files are replaced on each run).")
+              help="Output folder (created if missing).")
 @click.option("--upsample", default=8, show_default=True, type=click.IntRange(1, 32),
               help="Image pixels per element pitch.")
+@click.option("--force", is_flag=True, help="Replace the demo's files in --out if they exist.")
 @output_options
-def demo(out: Path, upsample: int, report: Reporter) -> None:
+def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
     """Simulate the paper's lab stand (letter R in sand) and image it.
 
     Writes figures, summary.json and the simulated hologram (hologram.nc) to
@@ -29,7 +30,7 @@ def demo(out: Path, upsample: int, report: Reporter) -> None:
     from ..demo import run_demo
 
     t0 = time.perf_counter()
-    s = run_demo(out, upsample=upsample)
+    s = run_demo(out, upsample=upsample, overwrite=force)
     th = s["theory"]
     pc = s["image_peak_m"]["targets_only"]
     mf, me = s["glare"]["mirror_image_found_m"], s["glare"]["mirror_image_expected_m"]
