@@ -131,10 +131,10 @@ def check_ground_permittivity(eps: complex, name: str = "eps") -> complex:
 
     Examples
     --------
-    >>> check_ground_permittivity(-2.5)
+    >>> check_ground_permittivity(-2.5)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: eps = (-2.5+0j) has a negative real part: a sign slip? holoradar's permittivities are eps' + i*eps'' with eps' >= 1 and loss as a positive imaginary part (e.g. sand 2.5+0.0125j)
+    ValueError: eps = (-2.5+0j) has a negative real part: a sign slip? ...
     """
     e = _check_eps(eps, name)
     if e.real < 0:
