@@ -375,3 +375,73 @@ def test_hdf5_external_storage_is_not_followed(tmp_path):
         f.create_dataset("data", shape=(8,), dtype="<f8", external=[(str(secret), 0, 64)])
     got = hr.io.read_variables(tmp_path / "ext.h5")
     assert "data" not in got and "not read" in " ".join(map(str, got["__other__"]))
+
+
+def _rows(sep: str = ",", decimal: str = ".") -> list[str]:
+    yy, xx = np.meshgrid(Y, X, indexing="ij")
+    out = []
+    for a, b, c, d in zip(xx.ravel(), yy.ravel(), FIELD.real.ravel(), FIELD.imag.ravel(),
+                          strict=True):
+        out.append(sep.join(repr(float(v)).replace(".", decimal) for v in (a, b, c, d)))
+    return out
+
+
+def test_csv_exports_as_spreadsheets_write_them(tmp_path):
+    """A byte-order mark, ';' with decimal commas, tabs, bracketed unit headers,
+    coordinates printed with rounding noise, a constant frequency column."""
+    p = tmp_path / "bom.csv"
+    p.write_text("\ufeffx,y,I,Q\n" + "\n".join(_rows()), encoding="utf-8")
+    _same(hr.load(p, layout="frequency=9.9e9"))
+    p = tmp_path / "semi.csv"
+    p.write_text("x;y;I;Q\n" + "\n".join(_rows(";", ",")))
+    _same(hr.load(p, layout="frequency=9.9e9"))
+    p = tmp_path / "tab.csv"
+    p.write_text("x [m]\ty [m]\tI [V]\tQ [V]\n" + "\n".join(_rows("\t")))
+    _same(hr.load(p, layout="x=x [m], y=y [m], i=I [V], q=Q [V], frequency=9.9e9"))
+    p = tmp_path / "noisy.csv"
+    rows = [r.split(",") for r in _rows()]
+    jitter = np.random.default_rng(1).uniform(-1e-12, 1e-12, (len(rows), 2))
+    lines = [",".join([repr(float(r[0]) + float(j[0])), repr(float(r[1]) + float(j[1])),
+                       r[2], r[3],
+                       "9.9e9"]) for r, j in zip(rows, jitter, strict=True)]
+    p.write_text("x,y,I,Q,frequency\n" + "\n".join(lines))
+    h = hr.load(p)
+    # each coordinate is the mean of its rows: within the 1e-12 m jitter of the truth
+    assert np.allclose(h.x, X, rtol=0, atol=1e-12) and h.data.shape == (6, 8)
+    assert h.frequency == F and np.array_equal(h.data, FIELD)
+    p.write_text("I,Q\n1,2\n3,4\n")
+    with pytest.raises(ValueError, match="a table needs x and y columns"):
+        hr.load(p, layout="frequency=9.9e9")
+
+
+def test_layout_edge_cases(tmp_path):
+    """Explicit keys override a sidecar even at their default; a declared pitch wins over
+    an index 'x'; a meshgrid is accepted; phases in degrees read as radians are caught;
+    MATLAB's (ny, nx, nf) order is hinted; one frequency adds no frame axis."""
+    np.save(tmp_path / "s.npy", FIELD)
+    (tmp_path / "s.json").write_text(json.dumps({"x": (X * 1e3).tolist(),
+                                                 "y": (Y * 1e3).tolist(),
+                                                 "frequency": F,
+                                                 "layout": {"units": "mm"}}))
+    assert np.allclose(hr.load(tmp_path / "s.npy").x, X, rtol=1e-15, atol=0)
+    with pytest.raises(ValueError, match="millimetres"):
+        hr.load(tmp_path / "s.npy", layout="units=m")  # back to the default: it wins
+    np.savez(tmp_path / "idx.npz", data=FIELD, x=np.arange(8.0), y=np.arange(6.0), f=F)
+    h = hr.load(tmp_path / "idx.npz", layout="pitch=0.025")
+    assert np.allclose(h.x, X, rtol=0, atol=1e-15)
+    with pytest.raises(ValueError, match="not both"):
+        hr.load(tmp_path / "idx.npz", layout="pitch=0.025, x=x")
+    gx, gy = np.meshgrid(X, Y)
+    scipy.io.savemat(tmp_path / "m.mat", {"data": FIELD, "X": gx, "Y": gy, "f": F})
+    _same(hr.load(tmp_path / "m.mat", layout="x=X, y=Y"))
+    np.savez(tmp_path / "deg.npz", amplitude=np.abs(FIELD), phase=np.degrees(np.angle(FIELD)),
+             x=X, y=Y, frequency=F)
+    with pytest.raises(ValueError, match="phase_unit=deg"):
+        hr.load(tmp_path / "deg.npz")
+    f3 = np.array([9e9, 9.5e9, 10e9])
+    np.savez(tmp_path / "yxf.npz", data=np.repeat(FIELD[..., None], 3, axis=-1), x=X, y=Y,
+             frequency=f3)
+    with pytest.raises(ValueError, match="axes=yxf"):
+        hr.load(tmp_path / "yxf.npz")
+    np.savez(tmp_path / "one.npz", data=FIELD[None], x=X, y=Y, frequency=np.array([F]))
+    assert hr.load(tmp_path / "one.npz").data.shape == (6, 8)

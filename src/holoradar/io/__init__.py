@@ -186,6 +186,8 @@ def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:
         raise ValueError(f"sidecar {path.name} is larger than 64 MiB")
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
+    except RecursionError:
+        raise ValueError(f"sidecar {path.name} is nested too deeply to be a layout") from None
     except (ValueError, UnicodeDecodeError) as exc:
         raise ValueError(f"sidecar {path.name} is not valid JSON ({exc})") from None
     if not isinstance(doc, dict):
@@ -197,7 +199,7 @@ def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:
             continue
         try:
             arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError, OverflowError):
+        except (TypeError, ValueError, OverflowError, RecursionError):
             continue
         if arr.ndim <= 2:
             extra[key] = arr

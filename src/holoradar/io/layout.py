@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -106,11 +106,14 @@ class Layout:
     phase_unit: str = "rad"
     iq_sign: str = "I+iQ"
     monostatic: bool = False
+    given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
+    """The keys set explicitly (by :meth:`from_mapping`): they win in :meth:`merged`
+    even where they equal the default."""
 
     def __post_init__(self) -> None:
         for name in ("data", "i", "q", "amplitude", "phase", "x", "y"):
             v = getattr(self, name)
-            if v is not None and (not isinstance(v, str) or not _REF.match(v)):
+            if v is not None and (not isinstance(v, str) or not v.strip()):
                 raise ValueError(f"layout {name} must be a variable name (optionally with "
                                  f"integer indices, e.g. E[1]), got {v!r}")
         if self.length_unit not in LENGTH_UNITS:
@@ -162,7 +165,7 @@ class Layout:
         m = dict(mapping)
         if "units" in m:
             m["length_unit"] = m.pop("units")
-        known = {f.name for f in fields(cls)}
+        known = {f.name for f in fields(cls)} - {"given"}
         unknown = sorted(set(m) - known)
         if unknown:
             raise ValueError(f"{what}: unknown key(s) {unknown}; known: {sorted(known)} "
@@ -170,7 +173,7 @@ class Layout:
         if isinstance(m.get("frequency"), list):
             m["frequency"] = tuple(m["frequency"])
         try:
-            return cls(**m)
+            return cls(**m, given=frozenset(m))
         except TypeError as exc:
             raise ValueError(f"{what}: {exc}") from None
 
@@ -201,13 +204,15 @@ class Layout:
         return cls.from_mapping(m)
 
     def merged(self, other: Layout | None) -> Layout:
-        """This layout with every field that ``other`` sets (differs from the default)."""
+        """This layout with every field that ``other`` sets: its explicitly given keys
+        (:meth:`parse`, :meth:`from_mapping`), or else those that differ from the default."""
         if other is None:
             return self
         default = Layout()
-        changes = {f.name: getattr(other, f.name) for f in fields(self)
-                   if getattr(other, f.name) != getattr(default, f.name)}
-        return replace(self, **changes)
+        keys = other.given or {f.name for f in fields(self) if f.name != "given"
+                               and getattr(other, f.name) != getattr(default, f.name)}
+        changes = {k: getattr(other, k) for k in keys}
+        return replace(self, **changes, given=self.given | frozenset(keys))
 
 
 def _is_number(text: str) -> bool:
@@ -236,6 +241,8 @@ def _describe(variables: Mapping[str, np.ndarray]) -> str:
 
 
 def _get(variables: Mapping[str, np.ndarray], ref: str, what: str) -> np.ndarray:
+    if ref in variables and not ref.startswith("__"):  # a name such as "I [V]" as it is
+        return np.asarray(variables[ref])
     m = _REF.match(ref)
     if m is None:
         raise ValueError(f"{what}: bad variable reference {ref!r}")
@@ -296,6 +303,9 @@ def _field(variables: Mapping[str, np.ndarray], lay: Layout, what: str) -> np.nd
         raise ValueError(f"{what}: amplitude {a.shape} and phase {p.shape} differ in shape")
     if a.dtype.kind not in "biuf" or p.dtype.kind not in "biuf":
         raise ValueError(f"{what}: amplitude and phase must be real numbers")
+    if lay.phase_unit == "rad" and p.size and float(np.max(np.abs(p))) > 2 * np.pi + 1e-6:
+        raise ValueError(f"{what}: phases up to {float(np.max(np.abs(p))):.4g} exceed 2 pi: "
+                         "degrees read as radians? (declare phase_unit=deg)")
     return a.astype(float) * np.exp(1j * p.astype(float) * _PHASE_UNITS[lay.phase_unit])
 
 
@@ -321,7 +331,13 @@ def _frequency(variables: Mapping[str, np.ndarray], lay: Layout, what: str) -> n
 
 def _coordinate(variables: Mapping[str, np.ndarray], lay: Layout, role: str, n: int,
                 what: str) -> np.ndarray | None:
-    ref = getattr(lay, role) or _find(variables, role)
+    named = getattr(lay, role)
+    if named is not None and lay.pitch is not None:
+        raise ValueError(f"{what}: the layout gives both {role}={named} and pitch={lay.pitch}: "
+                         "give the coordinates or the pitch, not both")
+    # A declared pitch wins over coordinates found under their usual names (the file's
+    # "x" may be an element index).
+    ref = named or (None if lay.pitch is not None else _find(variables, role))
     if ref is None:
         if lay.pitch is None:
             return None
@@ -329,6 +345,15 @@ def _coordinate(variables: Mapping[str, np.ndarray], lay: Layout, role: str, n: 
     v = _get(variables, ref, what)
     if v.dtype.kind not in "biuf":
         raise ValueError(f"{what}: coordinate {ref!r} must be real numbers, got {v.dtype}")
+    if v.ndim == 2 and min(v.shape) > 1:
+        # MATLAB's meshgrid: X(iy, ix) = x(ix) (rows alike), Y(iy, ix) = y(iy) (columns)
+        line = v[0, :] if role == "x" else v[:, 0]
+        alike = np.allclose(v, line[None, :] if role == "x" else line[:, None], rtol=0,
+                            atol=1e-9 * float(np.max(np.abs(v)) or 1.0))
+        if not alike:
+            raise ValueError(f"{what}: coordinate {ref!r} is a 2-D array {v.shape} that is not "
+                             f"a meshgrid of {role}: give the 1-D {role} of the elements")
+        v = line
     return np.ravel(v).astype(float) * LENGTH_UNITS[lay.length_unit]
 
 
@@ -336,18 +361,28 @@ def _default_axes(shape: tuple[int, ...], nf: int) -> str:
     nd = len(shape)
     if nd < 2:
         raise ValueError(f"the field must have at least 2 axes (y, x), got shape {shape}")
-    if nf > 1 and nd >= 3 and shape[-3] == nf:
+    if nd >= 3 and shape[-3] == nf:  # (nf == 1: a frequency axis of one, dropped)
         return "t" * (nd - 3) + "fyx"
     return "t" * (nd - 2) + "yx"
+
+
+def _levels(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct values of a table column and each row's index into them; values
+    within a millionth of the column's span are one (printing rounds coordinates)."""
+    order = np.unique(v)
+    tol = 1e-6 * float(order[-1] - order[0]) if order.size > 1 else 0.0
+    group = np.concatenate([[0], np.cumsum(np.diff(order) > tol)])
+    levels = np.array([order[group == g].mean() for g in range(int(group[-1]) + 1)])
+    return levels, group[np.searchsorted(order, v)]
 
 
 def _table(field: np.ndarray, xs: np.ndarray, ys: np.ndarray, fs: np.ndarray | None,
            what: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """Gather a table (one row per element and frequency) into a (nf,) ny x nx grid."""
-    ux, ix = np.unique(xs, return_inverse=True)
-    uy, iy = np.unique(ys, return_inverse=True)
-    if fs is not None and fs.size == field.size:
-        uf, jf = np.unique(fs, return_inverse=True)
+    ux, ix = _levels(xs)
+    uy, iy = _levels(ys)
+    if fs is not None and fs.size == field.size and np.unique(fs).size > 1:
+        uf, jf = _levels(fs)
     else:
         uf, jf = None, np.zeros(field.size, int)
     nf = 1 if uf is None else uf.size
@@ -402,7 +437,11 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
     if lay.iq_sign == "I-iQ":
         field = np.conj(field) if field.dtype.kind == "c" else field
     x_ref, y_ref = lay.x or _find(variables, "x"), lay.y or _find(variables, "y")
-    if field.ndim == 1 and x_ref is not None and y_ref is not None:
+    if field.ndim == 1 and (x_ref is None or y_ref is None):
+        raise ValueError(f"{what}: the field is one column ({field.size} values): a table "
+                         "needs x and y columns too; name them with the layout (x=..., "
+                         f"y=...). Found: {_describe(variables)}")
+    if field.ndim == 1:
         xs = _coordinate(variables, lay, "x", 0, what)
         ys = _coordinate(variables, lay, "y", 0, what)
         assert xs is not None and ys is not None
@@ -414,8 +453,7 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
             raise ValueError(f"{what}: a table's frequency must be one value or a column "
                              f"as long as the field, got {freq.size} values")
         grid, x, y, uf = _table(field, xs, ys, fs, what)
-        f: Any = uf if uf is not None and uf.size > 1 else float(fs[0] if fs is not None
-                                                                 else freq[0])
+        f: Any = uf if uf is not None else float(fs[0] if fs is not None else freq[0])
         return _hologram(grid, x, y, f, lay, what)
     axes = lay.axes or _default_axes(field.shape, freq.size)
     if len(axes) != field.ndim:
@@ -443,6 +481,9 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
     if x.size != nx or y.size != ny:
         hint = (" (x and y look swapped: declare axes=xy)"
                 if x.size == ny and y.size == nx and nx != ny else "")
+        if not lay.axes and freq.size > 1 and nx == freq.size:
+            hint = (f" (the last axis has {freq.size} entries, one per frequency: MATLAB's "
+                    "(ny, nx, nf) order? declare axes=yxf)")
         raise ValueError(f"{what}: the field's last axes are y={ny}, x={nx} but the "
                          f"coordinates hold y={y.size}, x={x.size}{hint}")
     if "f" in axes:
@@ -455,9 +496,13 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
     elif freq.size == 1:
         f = float(freq[0])
     else:
+        hint = ""
+        if not lay.axes and field.ndim == 3 and field.shape[-1] == freq.size:
+            hint = (f" (its last axis has {freq.size} entries: MATLAB's (ny, nx, nf) order? "
+                    "declare axes=yxf)")
         raise ValueError(f"{what}: {freq.size} frequencies but no frequency axis of that "
                          f"length in the field of shape {field.shape}: declare it in axes "
-                         "(e.g. axes=fyx)")
+                         f"(e.g. axes=fyx){hint}")
     return _hologram(field, x, y, f, lay, what)
 
 

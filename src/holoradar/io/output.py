@@ -24,14 +24,17 @@ def default_mode() -> int:
 
 def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
                  inputs: Iterable[str | os.PathLike[str]] = (), overwrite: bool = False,
-                 name: str = "path") -> Path:
+                 name: str = "path", folder: bool = False) -> Path:
     """Validate an output path before any computation; return it as a ``Path``.
+
+    ``folder=True`` for an output that is itself a folder (a Zarr store).
 
     Raises
     ------
     ValueError
         The suffix does not match the format, the path is one of the inputs, it
-        exists and ``overwrite`` is False, or its folder does not exist.
+        exists and ``overwrite`` is False, its folder does not exist or is not
+        writable, or it is a folder (for a file output).
 
     Examples
     --------
@@ -59,6 +62,10 @@ def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
                              "the data it was computed from")
     if not target.parent.is_dir():
         raise ValueError(f"{name}: the folder {str(target.parent)!r} does not exist")
+    if not os.access(target.parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{name}: the folder {str(target.parent)!r} is not writable")
+    if target.is_dir() and not folder:
+        raise ValueError(f"{name} {str(target)!r} is a folder")
     if target.exists() and not overwrite:
         raise ValueError(f"{name} {str(target)!r} exists: pass overwrite=True (--force on the "
                          "command line) to replace it")

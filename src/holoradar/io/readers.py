@@ -255,9 +255,11 @@ def read_csv(path: Path) -> dict[str, np.ndarray]:
     if size > MAX_ARRAY_BYTES:
         raise ValueError(f"{path.name} is larger than the {MAX_ARRAY_BYTES / 2**30:.0f} GiB "
                          "limit for a CSV table")
-    with open(path, newline="", encoding="utf-8", errors="strict") as fh:
-        rows = [r for r in csv.reader(line for line in fh if not line.lstrip().startswith("#"))
-                if any(c.strip() for c in r)]
+    # utf-8-sig: a spreadsheet's byte-order mark is not part of the first column's name
+    with open(path, newline="", encoding="utf-8-sig", errors="strict") as fh:
+        lines = [line for line in fh if line.strip() and not line.lstrip().startswith("#")]
+    delimiter = _delimiter(lines[:20])
+    rows = [r for r in csv.reader(lines, delimiter=delimiter) if any(c.strip() for c in r)]
     if not rows:
         raise ValueError(f"{path.name} holds no rows")
     header = [h.strip() for h in rows[0]]
@@ -276,10 +278,23 @@ def read_csv(path: Path) -> dict[str, np.ndarray]:
             raise ValueError(f"{path.name} line {n}: {len(row)} values for {len(header)} "
                              f"columns {header}")
         try:
-            table[n - 2] = [float(c) for c in row]
+            # with ';' or tabs between columns a decimal comma is common (1,5 = 1.5)
+            table[n - 2] = [float(c.replace(",", ".") if delimiter != "," else c)
+                            for c in row]
         except ValueError:
-            raise ValueError(f"{path.name} line {n}: not all numbers: {row}") from None
+            raise ValueError(f"{path.name} line {n}: not all numbers: {row} (columns "
+                             f"separated by {delimiter!r})") from None
     return {h: table[:, j].copy() for j, h in enumerate(header)}
+
+
+def _delimiter(lines: list[str]) -> str:
+    """The column separator of a CSV export: ',', ';', a tab or spaces."""
+    if not lines:
+        return ","
+    try:
+        return csv.Sniffer().sniff("".join(lines), delimiters=",;\t").delimiter
+    except csv.Error:
+        return ","
 
 
 def _is_number(text: str) -> bool:

@@ -52,6 +52,7 @@ A conductivity is turned into a permittivity at the (centre) frequency:
 
 from __future__ import annotations
 
+import inspect
 import math
 import tomllib
 from collections.abc import Mapping
@@ -61,6 +62,7 @@ from typing import Any
 
 import numpy as np
 
+from ..data.hologram import C0
 from ..data.pose import Pose
 from ..physics.medium import Medium, permittivity
 from ..physics.sources import GaussianBeam, PlaneWave, PointSource
@@ -248,6 +250,12 @@ def _targets(items: Any, where: str) -> list[PointTarget | PlanarTarget]:
                 raise ValueError(f"{w}.shape must be one of {shapes.__all__}, got {name!r}")
             sizes = {k: float(_number(t, k, w, positive=True, unit="m")) for k in t
                      if k not in ("type", "shape", "z", "center", "reflection", "pixel")}
+            takes = [p for p in inspect.signature(getattr(shapes, name)).parameters
+                     if p not in ("X", "Y")]
+            wrong = sorted(set(sizes) - set(takes))
+            if wrong:
+                raise ValueError(f"{w}: a {name} takes the sizes {takes} (metres), not "
+                                 f"{wrong}")
             out.append(PlanarTarget.from_shape(
                 name, float(_number(t, "z", w, positive=True, unit="m")),
                 center=_vector(t, "center", w, 2, (0.0, 0.0)),
@@ -289,6 +297,21 @@ def _within(where: str, build: Any, *args: Any) -> Any:
         raise ValueError(f"{where}: {exc}") from None
 
 
+def _plausible_pitch(aperture: Aperture, f_max: float, where: str) -> None:
+    """The checks :func:`~holoradar.data.plausibility.check_plausible` makes on a file."""
+    from ..data.plausibility import MAX_PITCH_WAVELENGTHS, MIN_PITCH_FRACTION
+
+    lam = C0 / f_max
+    for key, p in (("pitch", float(aperture.x[1] - aperture.x[0])),
+                   ("pitch_y", float(aperture.y[1] - aperture.y[0]))):
+        if p / lam > MAX_PITCH_WAVELENGTHS:
+            raise ValueError(f"{where}.aperture.{key} {p:g} m is {p / lam:.1f} wavelengths: "
+                             "millimetres or centimetres given for metres?")
+        if p / lam < 1 / MIN_PITCH_FRACTION:
+            raise ValueError(f"{where}.aperture.{key} {p:g} m is lambda/{lam / p:.0f}: a "
+                             "pitch in metres is expected")
+
+
 def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpec:
     """A :class:`SceneSpec` from a parsed TOML document (see the module's example)."""
     _unknown(doc, {"frequency", "aperture", "ground", "source", "target", "simulate"}, where)
@@ -327,6 +350,10 @@ def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpe
         "snr_db": _number(sim, "snr_db", f"{where}.simulate", None, unit="dB"),
         "seed": _number(sim, "seed", f"{where}.simulate", None, integer=True, minimum=0),
     }
+    _plausible_pitch(aperture, float(np.max(fl)), where)
+    if isinstance(source, GaussianBeam) and source.waist < C0 / float(np.max(fl)) / 4:
+        raise ValueError(f"{where}.source.waist {source.waist:g} m is below a quarter "
+                         "wavelength: such a beam is mostly evanescent (metres expected)")
     scene = Scene(medium, None if aperture.monostatic else source, targets)
     return SceneSpec(scene, aperture, freq, options)
 

@@ -116,7 +116,8 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     given = [Path(f) for f in frames]
     if not given:
         raise ValueError("frames: no frames given")
-    target = check_output(store, suffixes=[".zarr"], inputs=given, overwrite=True, name="store")
+    target = check_output(store, suffixes=[".zarr"], inputs=given, overwrite=True, name="store",
+                          folder=True)
     inside = [p for p in given if target.resolve() in p.resolve().parents]
     if inside:
         raise ValueError(f"store {str(target)!r} holds the frame {str(inside[0])!r}: refusing "

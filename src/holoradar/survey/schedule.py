@@ -9,6 +9,7 @@ and handed to Dask. ``scheduler`` names a local scheduler (``"processes"``,
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Sequence
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import nullcontext
@@ -87,7 +88,7 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
         delayed = [dask.delayed(func, pure=False)(t, job) for t in tasks]
         extra = {"pool": process_pool(local_workers(scheduler))} \
             if scheduler == "processes" else {}
-        with ProgressBar() if progress else nullcontext():
+        with ProgressBar(minimum=1.0, out=sys.stderr) if progress else nullcontext():
             try:
                 results = dask.compute(*delayed, scheduler=scheduler, **extra)
             except BrokenProcessPool as exc:

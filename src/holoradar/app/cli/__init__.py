@@ -28,6 +28,17 @@ def _show_warning(message: Any, category: type[Warning], filename: str, lineno: 
     click.echo(f"warning: {_one_line(str(message))} ({category.__name__})", err=True)
 
 
+def _fail(message: str, code: int, args: Any) -> None:
+    """One line on stderr; with --json also a JSON object on stdout for the caller."""
+    click.echo(f"error: {_one_line(message)}", err=True)
+    argv = sys.argv[1:] if args is None else list(args)
+    if "--json" in argv:
+        import json
+
+        click.echo(json.dumps({"error": _one_line(message), "exit_code": code}))
+    sys.exit(code)
+
+
 class HoloradarGroup(click.Group):
     """A click group whose user errors are one line and exit code 2, never a traceback."""
 
@@ -44,19 +55,23 @@ class HoloradarGroup(click.Group):
         except click.ClickException as exc:
             hint = f" (see {exc.ctx.command_path} --help)" if getattr(exc, "ctx", None) \
                 else ""
-            click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
-            sys.exit(2 if exc.exit_code in (1, 2) else exc.exit_code)
+            _fail(f"{exc.format_message()}{hint}", 2 if exc.exit_code in (1, 2)
+                  else exc.exit_code, args)
         except click.exceptions.Exit as exc:
             sys.exit(exc.exit_code)
         except click.Abort:
             click.echo("error: aborted", err=True)
             sys.exit(1)
-        except (ValueError, KeyError) as exc:
-            click.echo(f"error: {_one_line(str(exc))}", err=True)
-            sys.exit(2)
-        except OSError as exc:
-            click.echo(f"error: {_one_line(str(exc))}", err=True)
-            sys.exit(1)
+        except ValueError as exc:
+            _fail(str(exc), 2, args)
+        except MemoryError:
+            _fail("not enough memory for this job: fewer planes (--z), a smaller "
+                  "--upsample or a smaller array", 2, args)
+        except (PermissionError, FileNotFoundError, IsADirectoryError,
+                NotADirectoryError) as exc:
+            _fail(str(exc), 2, args)
+        except OSError as exc:  # the system's trouble (a full disk...), not the user's
+            _fail(str(exc), 1, args)
         finally:
             warnings.showwarning = old
 
