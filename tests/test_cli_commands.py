@@ -125,6 +125,11 @@ def test_scene_file_errors_name_the_key(tmp_path):
         ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[[target]]\nposition = [0, 0]\n",
          "target[0].position must be a list of 3 numbers"),
         ("frequency = [", "not valid TOML"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 25\n", "millimetres or centimetres"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[source]\ntype = 'gaussian'\n"
+         "waist = 1e-300\n", "quarter wavelength"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[[target]]\ntype = 'shape'\n"
+         "shape = 'disk'\nz = 0.4\nradius = 0.02\n", "takes the sizes ['diameter']"),
     ]:
         bad.write_text(text)
         res = run("simulate", bad, "-o", tmp_path / "h.nc", ok=False)
@@ -165,10 +170,10 @@ def test_reported_failures_are_fixed(tmp_path):
     one_line_error(run("image", tmp_path / "b.mat", "--z", "0.3", "-o", tmp_path / "i.png",
                        ok=False), "must end in")
     # --out equal to the input replaced the hologram with the image.
-    before = (tmp_path / "b.mat").read_bytes()
+    before = (tmp_path / "b.nc").read_bytes()
     one_line_error(run("image", tmp_path / "b.nc", "--z", "0.3", "-o", tmp_path / "b.nc",
                        ok=False), "one of the inputs")
-    assert (tmp_path / "b.mat").read_bytes() == before
+    assert (tmp_path / "b.nc").read_bytes() == before
     # A missing output folder failed only after the computation: now before it.
     one_line_error(run("image", tmp_path / "b.mat", "--z", "0.3", "-o",
                        tmp_path / "nowhere" / "i.nc", ok=False), "does not exist")
@@ -180,6 +185,15 @@ def test_reported_failures_are_fixed(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "a.nc", "a.npy", "a.png", "b.mat", "b.nc", "b.png", "e.npz", "ghz.npz", "mm.npz",
         "t.npz"]
+
+
+def test_json_errors_are_json_too(tmp_path):
+    """A program calling holoradar --json gets an error as JSON on stdout as well."""
+    res = run("image", tmp_path / "none.nc", "--z", "0.3", "-o", tmp_path / "i.nc", "--json",
+              ok=False)
+    assert res.exit_code == 2
+    doc = json.loads(res.stdout)
+    assert doc["exit_code"] == 2 and "does not exist" in doc["error"]
 
 
 def test_outputs_get_the_users_umask(tmp_path):
@@ -318,3 +332,25 @@ def test_batch_and_mosaic_from_the_command_line(tmp_path):
     # The stone at x = 0.12 m: within one map pixel (pitch / upsample = 5 mm).
     assert abs(peak[0] - 0.12) <= 0.005 and abs(peak[1]) <= 0.005
     run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.png", "-q")
+
+
+def test_calibrate_apply_reads_the_device_the_file_records(tmp_path):
+    """A raw file that records its device: another --device is refused, none needed."""
+    from holoradar import calibrate as cb
+
+    x = (np.arange(4) - 1.5) * 0.025
+    cal = cb.Calibration("HSR-7", x, x, F, iq_sign="I+iQ", response=[1.0],
+                         gains=np.ones((4, 4)))
+    cal.save(tmp_path / "cal.nc")
+    np.savez(tmp_path / "raw.npz", I=np.ones((4, 4)), Q=np.zeros((4, 4)), x=x, y=x,
+             frequency=F, device=np.array("HSR-7"))
+    run("calibrate", "apply", tmp_path / "raw.npz", "--calibration", tmp_path / "cal.nc",
+        "-o", tmp_path / "h.nc", "-q")
+    one_line_error(run("calibrate", "apply", tmp_path / "raw.npz", "--calibration",
+                       tmp_path / "cal.nc", "--device", "HSR-8", "-o", tmp_path / "g.nc",
+                       ok=False), "recorded by device 'HSR-7', not 'HSR-8'")
+    np.savez(tmp_path / "anon.npz", I=np.ones((4, 4)), Q=np.zeros((4, 4)), x=x, y=x,
+             frequency=F)
+    one_line_error(run("calibrate", "apply", tmp_path / "anon.npz", "--calibration",
+                       tmp_path / "cal.nc", "-o", tmp_path / "g.nc", ok=False), "--device")
+    assert not (tmp_path / "g.nc").exists()

@@ -50,4 +50,5 @@ def test_every_documented_command_runs(page, tmp_path, monkeypatch):
         res = CliRunner().invoke(main, [*args, "--quiet"] if args[0] != "demo" else
                                  [*args, "--upsample", "2", "--quiet"])
         assert res.exit_code == 0, f"holoradar {' '.join(args)}\n{res.output}"
-    assert not [p for p in os.listdir(tmp_path) if p.endswith(".tmp")]
+    left = [f for _, _, files in os.walk(tmp_path) for f in files if f.endswith(".tmp")]
+    assert not left  # no temporary file left behind anywhere (the examples link not followed)

@@ -248,7 +248,12 @@ def _seed_files(tmp: Path) -> dict[str, bytes]:
                                   FIELD.real.ravel().tolist(), FIELD.imag.ravel().tolist(),
                                   strict=True)]
         (tmp / "s.csv").write_text("\n".join(rows))
-        for name in ("s.npz", "s.npy", "s.mat", "s73.mat", "s.h5", "s.csv"):
+        import xarray as xr
+
+        xr.Dataset({"I": (("y", "x"), FIELD.real), "Q": (("y", "x"), FIELD.imag),
+                    "frequency": F}, coords={"x": X, "y": Y}).to_netcdf(tmp / "s_foreign.nc",
+                                                                        engine="h5netcdf")
+        for name in ("s.npz", "s.npy", "s.mat", "s73.mat", "s.h5", "s.csv", "s_foreign.nc"):
             _SEEDS[name] = (tmp / name).read_bytes()
     return _SEEDS
 
@@ -257,7 +262,8 @@ def _seed_files(tmp: Path) -> dict[str, bytes]:
 
 @settings(max_examples=int(os.environ.get("HOLORADAR_FUZZ_EXAMPLES", "150")), deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(name=st.sampled_from(["s.npz", "s.npy", "s.mat", "s73.mat", "s.h5", "s.csv"]),
+@given(name=st.sampled_from(["s.npz", "s.npy", "s.mat", "s73.mat", "s.h5", "s.csv",
+                             "s_foreign.nc"]),
        op=st.sampled_from(["truncate", "flip", "splice", "zero"]),
        where=st.floats(0, 1), byte=st.integers(0, 255), n=st.integers(1, 64))
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -279,7 +285,7 @@ def test_fuzzed_files_give_a_clear_error_or_a_valid_hologram(tmp_path, name, op,
     path.write_bytes(bytes(blob))
     before = path.read_bytes()
     listing = sorted(tmp_path.iterdir())
-    FUZZED["readers: damaged npz/npy/mat/mat7.3/h5/csv files"] += 1
+    FUZZED["readers: damaged npz/npy/mat/mat7.3/h5/csv/foreign-nc files"] += 1
     layout = Layout(pitch=0.025, frequency=F) if name == "s.npy" else None
     try:
         h = hr.load(path, layout=layout)
@@ -445,3 +451,31 @@ def test_layout_edge_cases(tmp_path):
         hr.load(tmp_path / "yxf.npz")
     np.savez(tmp_path / "one.npz", data=FIELD[None], x=X, y=Y, frequency=np.array([F]))
     assert hr.load(tmp_path / "one.npz").data.shape == (6, 8)
+
+
+_json = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-10**9, 10**9),
+                               st.floats(allow_nan=False), st.text(max_size=8)),
+                     lambda kids: st.one_of(st.lists(kids, max_size=5),
+                                            st.dictionaries(st.text(max_size=8), kids,
+                                                            max_size=5)), max_leaves=20)
+_layout_keys = ["data", "i", "q", "x", "y", "frequency", "pitch", "axes", "units",
+                "frequency_unit", "phase_unit", "iq_sign", "monostatic", "colour"]
+
+
+@settings(max_examples=150, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(doc=st.dictionaries(st.sampled_from(["x", "y", "frequency", "layout", "other"]),
+                           st.one_of(_json, st.dictionaries(st.sampled_from(_layout_keys),
+                                                            _json, max_size=4)),
+                           max_size=5))
+def test_fuzzed_sidecars_give_a_clear_error_or_a_hologram(tmp_path, doc):
+    """Any JSON beside a .npy: a ValueError or a valid hologram, nothing else."""
+    FUZZED["JSON sidecars"] += 1
+    np.save(tmp_path / "f.npy", FIELD)
+    (tmp_path / "f.json").write_text(json.dumps(doc))
+    try:
+        h = hr.load(tmp_path / "f.npy")
+    except ValueError as exc:
+        assert str(exc)
+    else:
+        assert isinstance(h, hr.Hologram) and np.all(np.isfinite(h.data))

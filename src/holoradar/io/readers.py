@@ -151,6 +151,8 @@ def read_mat(path: Path) -> dict[str, np.ndarray]:
         arr = np.asarray(value) if isinstance(value, np.ndarray) else None
         if arr is not None and arr.dtype.kind in "biufc":
             out[name] = np.array(arr)
+        elif arr is not None and arr.dtype.kind == "U" and arr.size == 1:  # a char array
+            out[name] = np.array(str(arr.reshape(()).item())[:256])
         else:
             out.setdefault("__other__", np.array([], dtype="U1"))
             out["__other__"] = np.append(out["__other__"], name)
@@ -216,6 +218,11 @@ def _read_hdf5(path: Path, *, matlab: bool = False) -> dict[str, np.ndarray]:
                 continue
             if v.dtype.kind in "biufc" and v.size <= 1_000_000:
                 out[f"{prefix}@{key}"] = v
+            elif v.dtype.kind in "SUO" and v.size == 1:  # a short text: an identity, units
+                text = v.reshape(()).item()
+                text = text.decode("utf-8", "replace") if isinstance(text, bytes) else text
+                if isinstance(text, str) and len(text) <= 256:
+                    out[f"{prefix}@{key}"] = np.array(text)
 
     try:
         with h5py.File(path, "r") as f:

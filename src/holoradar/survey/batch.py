@@ -24,7 +24,7 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
               z: float | Sequence[float], medium: Medium | None = None,
               method: str = "angular", upsample: int = 1, scheduler: str | None = None,
               strict: bool = False, overwrite: bool = False,
-              progress: bool = False) -> dict[str, Any]:
+              progress: bool = False, layout: Any = None) -> dict[str, Any]:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     Each frame (a hologram file written by :func:`holoradar.save`) is read with
@@ -66,6 +66,9 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         settings is resumed: frames marked done are not imaged again.
     progress : bool
         Show a progress bar.
+    layout : Layout, dict or str, optional
+        For frames in a user's format: where the hologram is in each file
+        (:func:`holoradar.load`); the same for every frame.
 
     Returns
     -------
@@ -131,7 +134,8 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     client = schedule.connect(sched) if sched not in schedule.LOCAL else None
     try:
         summary = _run(given, target, settings, sched, client, strict=bool(strict),
-                       overwrite=overwrite, exists=exists, progress=progress)
+                       overwrite=overwrite, exists=exists, progress=progress,
+                       layout=_layout_text(layout))
     finally:
         if client is not None:
             client.close()
@@ -139,8 +143,16 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     return summary
 
 
+def _layout_text(layout: Any) -> Any:
+    """A layout as something every worker can be sent (checked here, once)."""
+    from ..io import _as_layout
+
+    return _as_layout(layout)
+
+
 def _run(given: list[Path], target: Path, settings: Settings, sched: str, client: Any, *,
-         strict: bool, overwrite: bool, exists: bool, progress: bool) -> dict[str, Any]:
+         strict: bool, overwrite: bool, exists: bool, progress: bool,
+         layout: Any = None) -> dict[str, Any]:
     """The run itself, once the arguments are checked (see :func:`run_batch`)."""
     # Distinct frames, and the checks that need no reading, before anything is written.
     frames_in: list[tuple[Path, str]] = []  # (absolute path, name as given)
@@ -167,7 +179,7 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
                              + "; ".join(diff) + "): pass overwrite=True (--force on the "
                              "command line) to start it again, or choose another store")
     else:
-        found, refused = _reference(frames_in, strict)
+        found, refused = _reference(frames_in, strict, layout)
         for name, reason in refused:
             skipped.append({"name": name, "reason": reason})
         refused_names = {name for name, _ in refused}
@@ -184,7 +196,7 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
             if not done[slot]]
     workers = schedule.cluster_workers(client) if client is not None \
         else schedule.local_workers(sched)
-    job = Job(str(target), uuid.uuid4().hex, settings, geometry, strict)
+    job = Job(str(target), uuid.uuid4().hex, settings, geometry, strict, layout)
     records = schedule.run_tasks(process_chunk, schedule.split(todo, workers), job, sched,
                                  progress=progress, client=client) if todo else []
     skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
@@ -202,12 +214,12 @@ def _skip(skipped: list[dict[str, str]], name: str, reason: str, strict: bool) -
     skipped.append({"name": name, "reason": reason})
 
 
-def _reference(frames: list[tuple[Path, str]],
-               strict: bool) -> tuple[FrameGeometry | None, list[tuple[str, str]]]:
+def _reference(frames: list[tuple[Path, str]], strict: bool,
+               layout: Any = None) -> tuple[FrameGeometry | None, list[tuple[str, str]]]:
     """The geometry of the first frame that can be read, and the frames refused before it."""
     refused: list[tuple[str, str]] = []
     for path, name in frames:
-        holo, problem = read_frame(str(path), None)
+        holo, problem = read_frame(str(path), None, layout)
         if holo is not None:
             return FrameGeometry.of(holo), refused
         assert problem is not None

@@ -33,12 +33,14 @@ class Job:
     settings: Settings
     geometry: FrameGeometry
     strict: bool
+    layout: Any = None
 
 
-def read_frame(path: str, geometry: FrameGeometry | None) -> tuple[Hologram | None, str | None]:
+def read_frame(path: str, geometry: FrameGeometry | None,
+               layout: Any = None) -> tuple[Hologram | None, str | None]:
     """``(hologram, None)``, or ``(None, why it cannot be a frame)``."""
     try:
-        holo = load(path)
+        holo = load(path, layout=layout)
     except ValueError as exc:
         return None, str(exc)
     if not isinstance(holo, Hologram):
@@ -70,7 +72,7 @@ def process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
 
 def _process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
     t0 = time.perf_counter()
-    holo, problem = read_frame(path, job.geometry)
+    holo, problem = read_frame(path, job.geometry, job.layout)
     if holo is not None:
         s = job.settings
         try:

@@ -51,10 +51,13 @@ def _expand(patterns: tuple[str, ...]) -> list[Path]:
               help="Stop at the first bad frame instead of reporting and skipping it.")
 @click.option("--force", is_flag=True,
               help="Start the store afresh (settings changed) instead of refusing.")
+@click.option("--layout", default=None, metavar="KEY=VALUE,...",
+              help="For frames in a user's format: where the hologram is in each file (see "
+                   "holoradar image --help).")
 @output_options
 def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any], method: str,
           upsample: int, scheduler: str | None, strict: bool, force: bool,
-          report: Reporter) -> None:
+          layout: str | None, report: Reporter) -> None:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     FRAMES: hologram files or quoted patterns ('survey/*.nc'). A frame's position
@@ -69,11 +72,11 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
     if medium_spec["sigma"] is not None:  # a conductivity needs the frequency
         from ...io import load
 
-        freq = float(np.mean(load(files[0]).frequencies))
+        freq = float(np.mean(load(files[0], layout=layout).frequencies))
     medium = medium_from_options(medium_spec, freq)
     s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
                   scheduler=scheduler, strict=strict, overwrite=force,
-                  progress=report.progress and not report.as_json)
+                  progress=report.progress and not report.as_json, layout=layout)
     for w in s.get("warnings", []):  # raised in the workers: shown here once each
         category, _, message = w.partition(": ")
         click.echo(f"warning: {' '.join(message.split())} ({category})", err=True)

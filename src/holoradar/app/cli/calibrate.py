@@ -13,11 +13,53 @@ from .common import Reporter, input_history, output_options, triple
 __all__ = ["COMMANDS"]
 
 
-def _raw(path: Path, layout: str | None, device: str, source: Any, check: bool) -> Any:
+_DEVICE_KEYS = ("device", "@device", "serial", "@serial", "device_id", "@device_id")
+
+
+def file_device(path: Path) -> str | None:
+    """The device identity a raw file records (a text variable or attribute ``device``,
+    ``serial`` or ``device_id``, or the same key in its JSON sidecar), if any."""
+    from ...io.readers import read_variables
+
+    variables = dict(read_variables(path))
+    side = path.with_suffix(".json")
+    if side.is_file():
+        import json
+
+        try:
+            doc = json.loads(side.read_text(encoding="utf-8"))
+        except (ValueError, UnicodeDecodeError, RecursionError):
+            doc = {}
+        for k in _DEVICE_KEYS:
+            if isinstance(doc, dict) and isinstance(doc.get(k), str):
+                return doc[k]
+    for k in _DEVICE_KEYS:
+        v = variables.get(k)
+        if v is not None and v.dtype.kind in "SU" and v.size == 1:
+            return str(v.reshape(()).item())
+    return None
+
+
+def _device(path: Path, declared: str | None) -> str:
+    """The device that recorded ``path``: the file's own record, checked against
+    ``--device``; ``--device`` alone where the file records none."""
+    recorded = file_device(path)
+    if recorded is not None and declared is not None and recorded != declared:
+        raise ValueError(f"{path.name} was recorded by device {recorded!r}, not {declared!r} "
+                         "(--device)")
+    if recorded is None and declared is None:
+        raise click.BadParameter(f"{path.name} does not record its device: give --device",
+                                 param_hint="--device")
+    return recorded or declared  # type: ignore[return-value]
+
+
+def _raw(path: Path, layout: str | None, device: str | None, source: Any,
+         check: bool) -> Any:
     """Raw I and Q frames from any readable file (the field read as I + iQ, as recorded)."""
     from ...calibrate import RawFrames
     from ...io import load
 
+    device = _device(path, device)
     h = load(path, layout=layout, check=check)
     if not hasattr(h, "pose") or not hasattr(h, "monostatic"):
         raise ValueError(f"{path.name} holds an image, not raw frames")
@@ -48,7 +90,9 @@ def calibrate() -> None:
 
 
 @calibrate.command(name="fit")
-@click.option("--device", required=True, help="The device's identity (serial number).")
+@click.option("--device", default=None,
+              help="The device's identity (serial number); default: what the files record "
+                   "(a text variable or attribute device, serial or device_id).")
 @click.option("--plate", "plates", nargs=2, multiple=True, metavar="FILE RANGE",
               help="Repeats of a metal plate parallel to the array at RANGE metres (its "
                    "front face). Give two plates about lambda/8 apart to detect the I/Q sign.")
@@ -68,7 +112,7 @@ def calibrate() -> None:
               help="The calibration file, .nc.")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
 @output_options
-def fit(device: str, plates: tuple[tuple[str, str], ...], empties: tuple[Path, ...],
+def fit(device: str | None, plates: tuple[tuple[str, str], ...], empties: tuple[Path, ...],
         dark: Path | None, horn: str, horn_axis: str | None, pattern: float, iq_sign: str,
         layout: str | None, out: Path, force: bool, report: Reporter) -> None:
     """Fit a calibration: DC offsets, I/Q imbalance and sign, element gains, dead and
@@ -118,9 +162,9 @@ def fit(device: str, plates: tuple[tuple[str, str], ...], empties: tuple[Path, .
 @click.option("--calibration", "cal_file", required=True,
               type=click.Path(exists=True, dir_okay=False, path_type=Path),
               help="The device's calibration file (from calibrate fit).")
-@click.option("--device", required=True,
+@click.option("--device", default=None,
               help="The identity of the device that recorded RAW_FILE (must be the "
-                   "calibration's).")
+                   "calibration's); checked against what the file records, if it does.")
 @click.option("--horn", default=None,
               help="The horn's position x,y,z for these frames (default: the calibration's).")
 @click.option("--horn-axis", default=None, help="The horn's boresight x,y,z (default +z).")
@@ -131,7 +175,7 @@ def fit(device: str, plates: tuple[tuple[str, str], ...], empties: tuple[Path, .
               help="The calibrated hologram, .nc.")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
 @output_options
-def apply_cmd(raw_file: Path, cal_file: Path, device: str, horn: str | None,
+def apply_cmd(raw_file: Path, cal_file: Path, device: str | None, horn: str | None,
               horn_axis: str | None, pattern: float, layout: str | None, out: Path,
               force: bool, report: Reporter) -> None:
     """Calibrate RAW_FILE's frames into a hologram that the other commands image."""
@@ -146,7 +190,7 @@ def apply_cmd(raw_file: Path, cal_file: Path, device: str, horn: str | None,
     holo = cal.apply(raw)
     save(holo, out, overwrite=force,
          history=[*input_history(raw_file, layout), cal.history_step()])
-    report.done({"out": str(out), "device": device, "calibration": str(cal_file),
+    report.done({"out": str(out), "device": raw.device, "calibration": str(cal_file),
                  "shape": list(holo.data.shape)},
                 [f"calibrated {raw_file.name} with {cal_file.name} ({cal.device})",
                  f"wrote {out}"])
