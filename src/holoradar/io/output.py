@@ -15,8 +15,17 @@ def default_mode() -> int:
     """Permission bits a new file gets from ``open()``: ``0o666`` less the umask.
 
     Temporary files are created 0600; the finished file is given these bits so
-    that it looks like any other file the user writes.
+    that it looks like any other file the user writes. The umask is read from
+    ``/proc/self/status`` where the system has it: setting it to learn it (the
+    portable way) would briefly change it for the process's other threads.
     """
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
     mask = os.umask(0)
     os.umask(mask)
     return 0o666 & ~mask

@@ -82,7 +82,7 @@ def _read_npy_stream(fp: Any, available: int, what: str) -> np.ndarray:
         raise ValueError(f"{what} is truncated: {len(buf)} of {n * dtype.itemsize} bytes")
     arr = np.frombuffer(buf, dtype=dtype, count=n)
     arr = arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)
-    return np.array(arr)  # owned and writeable, in native order
+    return np.array(arr, dtype=arr.dtype.newbyteorder("="))  # owned, writeable, native order
 
 
 def read_npy(path: Path) -> dict[str, np.ndarray]:
