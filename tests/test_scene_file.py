@@ -95,3 +95,20 @@ def test_fuzzed_toml_text_gives_one_clear_error(tmp_path_factory, text):
     p.write_text(text, encoding="utf-8")
     with pytest.raises(ValueError):
         load_scene(p)
+
+
+@settings(max_examples=60, deadline=None)
+@given(doc=documents())
+def test_fuzzed_scenes_that_build_also_simulate(doc):
+    """A scene the parser accepts simulates, or says clearly why not (a ValueError)."""
+    FUZZED["scene parser: accepted scenes simulated"] += 1
+    try:
+        spec = scene_from_mapping(doc)
+    except ValueError:
+        return
+    try:
+        h = hr.simulate(spec.scene, spec.aperture, spec.frequency, **spec.options)
+    except ValueError as exc:
+        assert str(exc)
+    else:
+        assert np.all(np.isfinite(h.data))

@@ -354,7 +354,7 @@ def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpe
     if isinstance(source, GaussianBeam) and source.waist < C0 / float(np.max(fl)) / 4:
         raise ValueError(f"{where}.source.waist {source.waist:g} m is below a quarter "
                          "wavelength: such a beam is mostly evanescent (metres expected)")
-    scene = Scene(medium, None if aperture.monostatic else source, targets)
+    scene = Scene(medium, source, targets)  # (a monostatic aperture does not use it)
     return SceneSpec(scene, aperture, freq, options)
 
 
