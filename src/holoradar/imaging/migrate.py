@@ -103,7 +103,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     dtype : numpy dtype, optional
         Working precision: ``np.complex64`` for speed; default that of the data.
     progress : bool, optional
-        Show a progress bar; default: when the output exceeds 2e8 pixels.
+        Show a progress bar once the work has taken a second; default: only when
+        the output exceeds 2e8 pixels.
     combine : {"coherent", "incoherent", "none"}
         Several frequencies: ``"coherent"`` (default) sums the complex images of
         all frequencies, which focuses in depth (range resolution
@@ -268,7 +269,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
            else np.empty((*batch, zs.size, oy, ox), dtype=work))
     show = zs.size * oy * ox * max(1, int(np.prod(batch))) > 2e8 if progress is None \
         else progress
-    bar = tqdm(total=zs.size, desc="migrate", unit="plane") if show else None
+    # delay: a bar only for work that lasts (progress=True shows it after a second)
+    bar = tqdm(total=zs.size, desc="migrate", unit="plane", delay=1.0) if show else None
     chunk = zs.size if in_place else _CHUNK
     for c0 in range(0, zs.size, chunk):
         Ucs = op.adjoint_transfers[c0:c0 + chunk]

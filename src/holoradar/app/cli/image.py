@@ -95,7 +95,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
     medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
     t0 = time.perf_counter()
     img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
-                  progress=None if report.progress else False)
+                  progress=report.progress)
     seconds = time.perf_counter() - t0
     pk = peak_position(img)
     ground = None if medium is None else {"z_interfaces": list(medium.z_interfaces),
