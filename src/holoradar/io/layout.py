@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..data.hologram import Hologram
+from .readers import is_number as _is_number
 
 __all__ = ["FREQUENCY_UNITS", "LENGTH_UNITS", "Layout", "assemble"]
 
@@ -213,14 +214,6 @@ class Layout:
                                and getattr(other, f.name) != getattr(default, f.name)}
         changes = {k: getattr(other, k) for k in keys}
         return replace(self, **changes, given=self.given | frozenset(keys))
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _numeric(v: Any) -> bool:

@@ -273,7 +273,7 @@ def read_csv(path: Path) -> dict[str, np.ndarray]:
     if not all(header) or len(set(header)) != len(header):
         raise ValueError(f"{path.name}: the first row must name every column once, got "
                          f"{header}")
-    if all(_is_number(h) for h in header):
+    if all(is_number(h) for h in header):
         raise ValueError(f"{path.name}: the first row must be a header of column names "
                          f"(e.g. x,y,I,Q), got numbers {header}")
     body = rows[1:]
@@ -304,7 +304,8 @@ def _delimiter(lines: list[str]) -> str:
         return ","
 
 
-def _is_number(text: str) -> bool:
+def is_number(text: str) -> bool:
+    """Whether a text reads as a number."""
     try:
         float(text)
     except ValueError:
