@@ -48,7 +48,7 @@ from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram
 from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
-from ..physics.sources import PointSource
+from ..physics.sources import GaussianBeam, PointSource
 
 __all__ = ["FitWarning", "SuppressionReport", "estimate_permittivity", "suppress_surface"]
 
@@ -158,14 +158,19 @@ def _check(hologram: Hologram, medium: Medium, source: object, method: str) -> N
     if method not in ("gaussian", "cut", "image_source", "background"):
         raise ValueError("method must be 'gaussian', 'cut', 'image_source' or 'background', "
                          f"got {method!r}")
-    if method != "background" and not isinstance(source, PointSource):
-        raise ValueError(f"method {method!r} needs the radiator as a PointSource (its mirror "
-                         "image focuses); for a plane wave the glare is a plane wave: use "
-                         "method='background'")
+    if method != "background" and not isinstance(source, PointSource | GaussianBeam):
+        raise ValueError(f"method {method!r} needs the radiator as a PointSource or a "
+                         "GaussianBeam (its mirror image focuses); for a plane wave the glare "
+                         "is a plane wave: use method='background'")
     z0 = medium.z_interfaces[0]
-    if method != "background" and float(source.position[2]) >= z0:
+    if method != "background" and isinstance(source, PointSource) \
+            and float(source.position[2]) >= z0:
         raise ValueError(f"source range {float(source.position[2])} m must lie above the "
                          f"ground surface ({z0} m)")
+    if method != "background" and isinstance(source, GaussianBeam) \
+            and float(source.center[2]) > z0:
+        raise ValueError(f"source: the beam's waist (range {float(source.center[2])} m) must "
+                         f"not lie below the ground surface ({z0} m)")
 
 
 def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
@@ -182,8 +187,13 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         One view, on a uniform grid.
     medium : Medium
         The ground (its surface range z0 sets the mirror plane).
-    source : PointSource, optional
-        The radiator; default ``hologram.source``.
+    source : PointSource or GaussianBeam, optional
+        The radiator; default ``hologram.source``. A Gaussian beam's glare is the
+        beam reflected by the stack (each plane-wave component with its own
+        reflection coefficient): a beam from the mirror image of its waist,
+        travelling along the mirrored axis; its incoming beam crossing the array
+        is the direct wave. For a Gaussian beam ``"gaussian"`` reports no eps (the
+        beam's own amplitude is not a point source's): use ``"image_source"``.
     method : {"gaussian", "cut", "image_source", "background"}
         See the module docstring.
     background : Hologram, optional
@@ -245,7 +255,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     """
     src = source if source is not None else getattr(hologram, "source", None)
     if src is None and method != "background":
-        raise ValueError("source must be given (the radiator as a PointSource), or carried "
+        raise ValueError("source must be given (the radiator as a PointSource or a "
+                         "GaussianBeam), or carried "
                          "by the hologram (Hologram(..., source=...))")
     if fit_domain not in ("aperture", "mirror"):
         raise ValueError(f"fit_domain must be 'aperture' or 'mirror', got {fit_domain!r}")
@@ -301,6 +312,10 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     report_kw: dict[str, Any] = {"mirror_plane": z_m}
     if method == "cut":
         r = cut_radius if cut_radius is not None else 1.5 * cell
+        if cut_radius is None and isinstance(src, GaussianBeam):
+            # the reflected beam's spot is its waist blurred by the aperture: cover
+            # two waists (the beam's amplitude there is e^-4, -35 dB)
+            r = float(np.hypot(1.5 * cell, 2 * src.waist))
         gx, gy = _grid_coords(hologram, op)
         dist = np.hypot(gx[None, :] - xs, gy[:, None] - ys)
         if taper:
@@ -308,10 +323,20 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
             mask = 0.5 - 0.5 * np.cos(np.pi * mask)
         else:
             mask = (dist <= r).astype(float)
-        removed_grid = sfft.ifft2(sfft.fft2(E_before * mask, workers=op.workers)
-                                  * op.transfers[0], workers=op.workers)
-        glare = removed_grid[:data.shape[0], :data.shape[1]].ravel()
+        def bite(v: np.ndarray) -> np.ndarray:
+            E = _mirror_image(op, v.reshape(data.shape))
+            back = sfft.ifft2(sfft.fft2(E * mask, workers=op.workers) * op.transfers[0],
+                              workers=op.workers)
+            return back[:data.shape[0], :data.shape[1]].ravel()
+
+        glare = bite(h)
         dcoef, glare, direct_part = _joint_direct(h, glare, D)
+        if D is not None:
+            # The direct wave leaves part of itself in the masked spot: take it out
+            # first and bite again (a second pass changes the result by the direct
+            # wave's share of the spot, no more).
+            glare = bite(h - direct_part)
+            dcoef, glare, direct_part = _joint_direct(h, glare, D)
         report_kw.update(mirror_position=_world(pose, xs, ys, z_m), waist=r, amplitude=None)
         converged, params = True, {"x": xs, "y": ys}
     elif method == "gaussian":
@@ -323,8 +348,15 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
             def transform(v: np.ndarray) -> np.ndarray:
                 return _mirror_image(op, v.reshape(data.shape))[window]
 
+        u_beam, b0 = None, None
+        if isinstance(src, GaussianBeam):
+            # The reflected beam's axis (the incident one mirrored), in the aperture's
+            # frame, and its waist: the fit starts from them and lets the waist vary.
+            d = src.direction * np.array([1.0, 1.0, -1.0])
+            u_beam = np.array([d @ pose.u, d @ pose.v, d @ pose.normal])
+            b0 = k * src.waist**2 / 2
         glare, direct_part, dcoef, fit = _fit_gaussian(k, local, h, D, xs, ys, z_m, cell,
-                                                       initial, transform)
+                                                       initial, transform, u_beam, b0)
         xc, yc, zc, b = fit["x"], fit["y"], fit["z"], fit["b"]
         report_kw.update(mirror_position=_world(pose, xc, yc, zc), amplitude=fit["a"],
                          phase=float(np.angle(fit["a"])), waist=float(np.sqrt(2 * b / k)))
@@ -347,7 +379,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         direct_removed_db=None if D is None else _db(float(np.sum(np.abs(direct_part) ** 2)),
                                                      left),
         direct_amplitude=dcoef, converged=converged, parameters=params)
-    if method == "gaussian":
+    if method == "gaussian" and isinstance(src, PointSource):
         # The radiator's amplitude: given, or the direct wave's when one was found (it
         # carries at least 1% of the hologram's energy), else the source's own.
         ref = reference_amplitude
@@ -371,9 +403,10 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                                                                                **report_kw)
 
 
-def _direct_wave(src: PointSource, k: float, pts: np.ndarray) -> np.ndarray:
+def _direct_wave(src: PointSource | GaussianBeam, k: float, pts: np.ndarray) -> np.ndarray:
     """The radiator's own wave at air points, for unit amplitude: ``exp(ikR)/R`` times its
-    pattern along the straight ray (the shape the direct-wave fit scales)."""
+    pattern along the straight ray, or the incoming Gaussian beam (the shape the
+    direct-wave fit scales)."""
     return replace(src, amplitude=1.0).field(k, Medium.free_space(), pts)
 
 
@@ -394,16 +427,26 @@ def _linear_fit(h: np.ndarray, basis: list[np.ndarray]) -> tuple[np.ndarray, np.
     return coef, B @ coef
 
 
-def _csp_beam(k: float, pts: np.ndarray, x: float, y: float, z: float, b: float) -> np.ndarray:
-    """Complex-source-point beam exp(i k Rc)/Rc seen at ``pts`` (travelling towards -z)."""
-    Rc = np.sqrt((pts[:, 0] - x) ** 2 + (pts[:, 1] - y) ** 2 + (z - pts[:, 2] - 1j * b) ** 2)
+def _csp_beam(k: float, pts: np.ndarray, x: float, y: float, z: float, b: float,
+              u: np.ndarray | None = None) -> np.ndarray:
+    """Complex-source-point beam exp(i k Rc)/Rc seen at ``pts``: waist at (x, y, z),
+    travelling along the unit vector ``u`` (default -z, towards the aperture).
+
+    The source sits at the complex point ``c + i*b*u``: ``Rc = |r - c - i*b*u|`` is, on
+    the axis, the distance along it less ``i*b``, a Gaussian beam of waist
+    ``sqrt(2*b/k)``.
+    """
+    ux, uy, uz = (0.0, 0.0, -1.0) if u is None else (float(u[0]), float(u[1]), float(u[2]))
+    Rc = np.sqrt((pts[:, 0] - x - 1j * b * ux) ** 2 + (pts[:, 1] - y - 1j * b * uy) ** 2
+                 + (pts[:, 2] - z - 1j * b * uz) ** 2)
     Rc = np.where(Rc.real < 0, -Rc, Rc)
     return np.exp(1j * k * Rc) / Rc
 
 
 def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None, xs: float,
                   ys: float, z_m: float, cell: float, initial: dict[str, Any] | None,
-                  transform: Callable[[np.ndarray], np.ndarray] | None = None):
+                  transform: Callable[[np.ndarray], np.ndarray] | None = None,
+                  u: np.ndarray | None = None, b0: float | None = None):
     """Fit ``a*beam + d*D`` to the data, in the domain ``transform`` maps them to.
 
     ``transform`` is the windowed image of the mirror plane (the paper's choice:
@@ -413,16 +456,24 @@ def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None
     scale = cell
     # The spot lies in the mirror plane by construction: its range is not fitted (a
     # free range lets the beam swallow a buried reflector's own, deeper, focus).
-    x0 = np.array([xs, ys, 0.01 * cell]) if not initial else np.array(
+    start_b = 0.01 * cell if b0 is None else b0
+    x0 = np.array([xs, ys, start_b]) if not initial else np.array(
         [initial["x"], initial["y"], max(initial["b"], 1e-6)])
     T = transform if transform is not None else (lambda v: v)
     th = T(h).ravel()
     tD = None if D is None else T(D).ravel()
 
     def parts(theta: np.ndarray):
-        G = _csp_beam(k, pts, theta[0], theta[1], z_m, theta[2])
-        basis = [T(G).ravel()] if tD is None else [T(G).ravel(), tD]
+        G = _csp_beam(k, pts, theta[0], theta[1], z_m, theta[2], u)
+        # exp(ik Rc)/Rc grows as exp(k b) with the waist (1e33 for a 6 cm beam at
+        # 10 GHz): scale it to unit norm so that the joint fit with the direct wave is
+        # well conditioned, and scale its coefficient back.
+        norm = float(np.linalg.norm(G)) or 1.0
+        tG = T(G / norm).ravel()
+        basis = [tG] if tD is None else [tG, tD]
         coef, model = _linear_fit(th, basis)
+        coef = coef.copy()
+        coef[0] /= norm
         return coef, model, G
 
     def resid(u: np.ndarray) -> np.ndarray:
@@ -435,8 +486,10 @@ def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None
     # The mirror image of a horn is a spot no wider than the horn's mouth: its waist is
     # bounded by one wavelength. A wider beam would swallow the defocused, but nearby
     # in range, specular return of a buried planar reflector.
-    b_max = k * (2 * np.pi / k) ** 2 / 2
-    lo = np.array([-3.0, -3.0, -x0[2] / scale])
+    # A Gaussian-beam radiator's reflected beam has the radiator's own waist: allow it
+    # half to twice that (the stack's reflection reshapes the spectrum a little).
+    b_max = k * (2 * np.pi / k) ** 2 / 2 if b0 is None else 4 * b0
+    lo = np.array([-3.0, -3.0, (-x0[2] if b0 is None else 0.25 * b0 - x0[2]) / scale])
     hi = np.array([3.0, 3.0, (b_max - x0[2]) / scale])
     sol = least_squares(resid, np.clip(np.zeros(3), lo, hi), bounds=(lo, hi), xtol=1e-10,
                         ftol=1e-12, max_nfev=400)
@@ -614,7 +667,7 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     4.0
     """
     src = source if source is not None else getattr(hologram, "source", None)
-    if direct and isinstance(src, PointSource):
+    if direct and isinstance(src, PointSource | GaussianBeam):
         D = _direct_wave(src, hologram.k, hologram.points)
         h = hologram.data.ravel()
         share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)

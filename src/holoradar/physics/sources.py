@@ -359,6 +359,32 @@ class GaussianBeam:
             out[sel] = self._sum(P, Q, A * T, pts[sel]) * dpq / (4 * np.pi**2)
         return out
 
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit vector of the beam's axis (towards +z, into the scene)."""
+        sa, sb = np.sin(self.alpha), np.sin(self.beta)
+        return np.array([sa, sb, np.sqrt(1 - sa * sa - sb * sb)])
+
+    def mirror_position(self, medium: Medium) -> np.ndarray:
+        """The waist of the beam reflected by the surface: the mirror image of the
+        incident waist, range ``2*z0 - z_w`` (a plane mirror images the whole beam;
+        each of its plane waves keeps its own reflection coefficient, which shapes
+        the reflected beam's amplitude, not where it focuses).
+
+        Examples
+        --------
+        >>> GaussianBeam(0.05, center=(0.0, -0.1, 0.1)).mirror_position(
+        ...     Medium.half_space(0.3, 2.5)).round(6).tolist()
+        [0.0, -0.1, 0.5]
+        """
+        if medium.is_free_space:
+            raise ValueError("a free-space medium has no surface and no mirror image")
+        z0 = medium.z_interfaces[0]
+        if self.center[2] > z0:
+            raise ValueError(f"the beam's waist (range {float(self.center[2])} m) must not lie "
+                             f"below the ground surface ({z0} m) for its glare to be modelled")
+        return np.array([self.center[0], self.center[1], 2 * z0 - self.center[2]])
+
     def reflected(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
         """Specular reflection from the ground at air points (N, 3)."""
         pts = _points(points)
