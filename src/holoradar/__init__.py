@@ -35,6 +35,7 @@ from .model.scene import Aperture, Scene
 from .model.simulate import simulate
 from .model.targets import PlanarTarget, PointTarget
 from .physics.medium import Medium, permittivity
+from .physics.parabolic import ParabolicEquation
 from .physics.propagation import AngularSpectrum, Fresnel
 from .physics.sources import GaussianBeam, PlaneWave, PointSource
 
@@ -53,6 +54,7 @@ __all__ = [
     "Image",
     "Medium",
     "ObliquePlan",
+    "ParabolicEquation",
     "PlanarTarget",
     "PlaneWave",
     "PointSource",

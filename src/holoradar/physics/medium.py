@@ -24,7 +24,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
@@ -268,6 +268,81 @@ class Medium:
             raise ValueError(f"eps must have one value per interface ({len(zi)}), got {len(ep)}")
         ep = tuple(check_ground_permittivity(e, f"eps[{j}]") for j, e in enumerate(ep))
         return cls(zi, (1.0, *ep), polarization)
+
+    @classmethod
+    def graded(cls, z_surface: float, eps: Any, depth: float, *, step: float | None = None,
+               polarization: Polarization = "TE") -> Medium:
+        """A smoothly stratified ground: permittivity varying with depth, as thin layers.
+
+        Below the surface at ``z_surface`` the permittivity follows ``eps`` down to
+        ``depth`` below the surface, then stays at its last value. The profile is
+        sampled at the middle of layers ``step`` thick, and the result is an
+        ordinary layered :class:`Medium`: every propagator treats it exactly
+        (transmission, reflections, reverberations), and the parabolic-equation
+        propagator (:class:`~holoradar.physics.parabolic.ParabolicEquation`) steps
+        through the same profile.
+
+        Parameters
+        ----------
+        z_surface : float
+            Range of the surface from the aperture, metres (> 0).
+        eps : callable or (array_like, array_like)
+            ``eps(d)`` of the depth ``d`` below the surface (metres, array in,
+            complex array out), or samples ``(depths, values)`` with depths
+            increasing from 0, interpolated linearly (real and imaginary parts).
+            Every value a ground permittivity: eps' >= 1, Im(eps) >= 0.
+        depth : float
+            Depth of the graded part, metres (> 0).
+        step : float, optional
+            Layer thickness, metres; default ``depth / 200``. It must resolve the
+            profile: not larger than the spacing of the given samples.
+        polarization : {"TE", "TM"}
+
+        Examples
+        --------
+        >>> wet = Medium.graded(0.30, lambda d: 3.0 + 20.0 * d, 0.30, step=0.01)
+        >>> len(wet.z_interfaces), round(wet.eps[1].real, 6), round(wet.eps[-1].real, 6)
+        (30, 3.1, 8.9)
+        """
+        try:
+            z0, dep = float(z_surface), float(depth)
+        except (TypeError, ValueError):
+            raise ValueError("z_surface and depth must be metres (numbers > 0), got "
+                             f"{z_surface!r}, {depth!r}") from None
+        if not (np.isfinite(z0) and z0 > 0 and np.isfinite(dep) and dep > 0):
+            raise ValueError(f"z_surface and depth must be metres > 0, got {z0}, {dep}")
+        h = dep / 200 if step is None else float(step)
+        if not (np.isfinite(h) and 0 < h <= dep):
+            raise ValueError(f"step must be a thickness in metres, 0 < step <= depth ({dep}), "
+                             f"got {step!r}")
+        n = int(np.ceil(dep / h - 1e-9))
+        mids = (np.arange(n) + 0.5) * (dep / n)
+        if callable(eps):
+            try:
+                values = np.broadcast_to(np.asarray(eps(mids), complex), mids.shape)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"eps(depth) must return permittivities for an array of "
+                                 f"depths ({exc})") from None
+        else:
+            try:
+                dz, ev = (np.asarray(v) for v in eps)
+                dz = dz.astype(float)
+                ev = ev.astype(complex)
+            except (TypeError, ValueError):
+                raise ValueError("eps must be a function of depth or samples (depths, "
+                                 "values)") from None
+            if dz.ndim != 1 or dz.shape != ev.shape or dz.size < 2 or np.any(np.diff(dz) <= 0) \
+                    or dz[0] != 0:
+                raise ValueError("eps samples must be (depths, values) of one length >= 2, "
+                                 "depths increasing from 0 m")
+            if h > float(np.min(np.diff(dz))) * (1 + 1e-9):
+                raise ValueError(f"step {h} m is larger than the profile's sample spacing "
+                                 f"{float(np.min(np.diff(dz)))} m: it would skip its detail")
+            values = (np.interp(mids, dz, ev.real) + 1j * np.interp(mids, dz, ev.imag))
+        ep = [check_ground_permittivity(v, f"eps at depth {d:.4g} m")
+              for d, v in zip(mids, values, strict=True)]
+        tops = z0 + np.arange(n) * (dep / n)
+        return cls(tuple(float(t) for t in tops), (1.0, *ep), polarization)
 
     # --------------------------------------------------------------- properties
     @property
