@@ -65,8 +65,9 @@ def documents(draw):
             else:
                 doc[key] = value
         elif table == "target":
-            if isinstance(doc.get("target"), list) and doc["target"]:
-                doc["target"][0][key] = value
+            targets = doc.get("target")
+            if isinstance(targets, list) and targets and isinstance(targets[0], dict):
+                targets[0][key] = value
         elif isinstance(doc.get(table), dict):
             if draw(st.booleans()):
                 doc[table].pop(key, None)
