@@ -125,9 +125,15 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     """
     src = Path(path)
     lay = _as_layout(layout)
-    if src.suffix.lower() in NETCDF_SUFFIXES and lay is None and _is_holoradar_netcdf(src):
-        obj = _load_netcdf(src)
-    else:
+    obj = None
+    if src.suffix.lower() in NETCDF_SUFFIXES and lay is None:
+        try:  # holoradar's own file, read in one pass (a survey reads thousands)
+            obj = read_direct(src)
+        except Exception:  # not ours, or damaged: decided below
+            obj = None
+        if obj is None and _is_holoradar_netcdf(src):
+            obj = _load_netcdf(src)  # ours but odd: the xarray reader names the problem
+    if obj is None:
         variables = read_variables(src)
         sidecar = src.with_suffix(".json")
         side_layout = None
@@ -209,16 +215,9 @@ def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:
 
 
 def _load_netcdf(src: Path) -> Hologram | Image:
+    """A holoradar file through xarray: the slower reader, whose errors explain."""
     import xarray as xr
 
-    if not src.is_file():
-        raise ValueError(f"path {str(src)!r} is not a file")
-    if src.stat().st_size == 0:
-        raise ValueError(f"path {str(src)!r} is empty")
-    try:
-        return read_direct(src)
-    except Exception:  # anything odd: the xarray path below names the problem
-        pass
     try:
         with xr.open_dataset(src, engine="h5netcdf") as ds:
             ds.load()

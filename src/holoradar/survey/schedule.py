@@ -138,7 +138,7 @@ def process_pool(workers: int) -> Any:
         method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
         ctx = mp.get_context(method)
         if method == "forkserver":
-            ctx.set_forkserver_preload(["holoradar.survey.worker", "xarray", "h5netcdf"])
+            ctx.set_forkserver_preload(["holoradar.survey.worker", "h5py"])
         pool = ProcessPoolExecutor(workers, mp_context=ctx)
         for old in _POOL.values():  # another size asked: let the old pool's processes go
             old.shutdown(wait=False)
