@@ -354,3 +354,24 @@ def test_calibrate_apply_reads_the_device_the_file_records(tmp_path):
     one_line_error(run("calibrate", "apply", tmp_path / "anon.npz", "--calibration",
                        tmp_path / "cal.nc", "-o", tmp_path / "g.nc", ok=False), "--device")
     assert not (tmp_path / "g.nc").exists()
+
+
+def test_autofocus_from_the_command_line_equals_the_library(tmp_path):
+    truth = hr.Medium.half_space(0.30, 4.0 * (1 + 0.005j))
+    scene = hr.Scene(truth, hr.PlaneWave(), [hr.PointTarget((0.01, -0.02, 0.38))])
+    h = hr.simulate(scene, hr.Aperture.paper(), F, include_surface=False, snr_db=40, seed=0)
+    hr.save(h, tmp_path / "h.nc")
+    res = run("autofocus", tmp_path / "h.nc", "--z-surface", "0.30", "--tan-delta", "0.005",
+              "--plot", tmp_path / "f.png", "--json")
+    got = json.loads(res.stdout)
+    lib = hr.autofocus(h, medium_model=hr.Medium.half_space(0.30, 3.0 * (1 + 0.005j)))
+    assert got["eps"] == pytest.approx(lib.eps, rel=1e-9)
+    assert got["eps_interval"] == pytest.approx(list(lib.eps_interval), rel=1e-9)
+    assert (tmp_path / "f.png").stat().st_size > 0
+    one_line_error(run("autofocus", tmp_path / "h.nc", "--z-surface", "0.30", "--plot",
+                       tmp_path / "f.png", ok=False), "--plot")  # exists: needs --force
+    one_line_error(run("autofocus", tmp_path / "h.nc", ok=False), "--z-surface")
+    one_line_error(run("autofocus", tmp_path / "h.nc", "--z-surface", "0.3", "--eps-range",
+                       "3", ok=False), "--eps-range")
+    one_line_error(run("autofocus", tmp_path / "h.nc", "--layers", "0.3:3,0.4:5", ok=False),
+                   "half-space")

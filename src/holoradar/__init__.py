@@ -20,6 +20,7 @@ from .analysis.oblique_plan import ObliquePlan, plan_oblique
 from .data.hologram import C0, Hologram, Image
 from .data.pose import Pose
 from .data.wideband import apply_calibration, conjugate, remove_mean
+from .imaging.autofocus import AutofocusResult, autofocus
 from .imaging.iq import iq_convention
 from .imaging.migrate import IlluminationWarning, migrate
 from .imaging.reflection import (
@@ -46,6 +47,7 @@ __all__ = [
     "AliasingWarning",
     "AngularSpectrum",
     "Aperture",
+    "AutofocusResult",
     "FitWarning",
     "Fresnel",
     "GaussianBeam",
@@ -66,6 +68,7 @@ __all__ = [
     "__version__",
     "align_phases",
     "apply_calibration",
+    "autofocus",
     "calibrate",
     "conjugate",
     "estimate_permittivity",

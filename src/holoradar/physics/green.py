@@ -33,7 +33,7 @@ from typing import Literal
 
 import numpy as np
 from scipy.interpolate import CubicSpline
-from scipy.special import j0
+from scipy.special import j0, roots_legendre
 
 from .medium import Medium
 
@@ -55,8 +55,10 @@ def free_space_green(k: complex, src: np.ndarray, pts: np.ndarray) -> np.ndarray
 
 @functools.lru_cache(maxsize=64)
 def _legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    # Gauss-Legendre rules cost an eigenvalue problem of size n: computed once per n.
-    x, w = np.polynomial.legendre.leggauss(n)
+    # Gauss-Legendre rules are computed once per n: numpy's eigenvalue problem for small
+    # n, scipy's asymptotic expansions (exact to ~1e-11, O(n)) for large n, where the
+    # eigenvalue problem costs 0.07 s at n = 1024 and 0.5 s at 2048.
+    x, w = np.polynomial.legendre.leggauss(n) if n <= 512 else roots_legendre(n)
     x.setflags(write=False)
     w.setflags(write=False)
     return x, w
@@ -313,8 +315,8 @@ def transmitted_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarr
     for kap, w in pieces:
         k2 = kap**2
         J = j0(np.outer(rho, kap))                                  # (nrho, nkappa)
-        f = np.stack([1j * medium.vertical_transfer(k, k2, z_src, float(z_obs[i])) * kap
-                      / medium.kz(k, k2, 0) for i in deep])          # (nz, nkappa)
+        f = 1j * medium.vertical_transfers(k, k2, z_src, z_obs[deep]) * (
+            kap / medium.kz(k, k2, 0))                               # (nz, nkappa)
         acc += (f * w) @ J.T
     out[deep] = acc
     return out

@@ -563,6 +563,46 @@ class Medium:
             return air * self._field_in(st, region, z_far)
         return air * self._up_from(st, region, z_far)
 
+    def vertical_transfers(self, k: float, kappa2: np.ndarray, z_from: float,
+                           z_to: np.ndarray) -> np.ndarray:
+        """:meth:`vertical_transfer` down from ``z_from`` in the air to many ranges at once.
+
+        The stack's coefficients are computed once for all the ranges ``z_to``
+        (each >= ``z_from``); returns shape ``(len(z_to),) + kappa2.shape``.
+
+        Examples
+        --------
+        >>> m = Medium.half_space(0.3, 4.0)
+        >>> k2 = np.array([0.0, 900.0])
+        >>> t = m.vertical_transfers(200.0, k2, 0.0, np.array([0.2, 0.4]))
+        >>> bool(np.allclose(t[1], m.vertical_transfer(200.0, k2, 0.0, 0.4)))
+        True
+        """
+        kappa2 = np.asarray(kappa2, dtype=float)
+        z_to = np.atleast_1d(np.asarray(z_to, dtype=float))
+        if self.region_of(float(z_from)) != 0 or np.any(z_to < z_from):
+            raise ValueError("vertical_transfers goes down from the air: z_from must lie above "
+                             f"the surface and every z_to below z_from, got {z_from}, {z_to}")
+        out = np.empty(z_to.shape + kappa2.shape, complex)
+        regions = np.atleast_1d(self.region_of(z_to))
+        kz0 = self.kz(k, kappa2, 0)
+        st = self._interfaces(k, kappa2) if np.any(regions > 0) else None
+        for region in np.unique(regions):
+            sel = np.nonzero(regions == region)[0]
+            dz = z_to[sel][:, None]
+            if region == 0:
+                out[sel] = np.exp(1j * kz0 * (dz - z_from))
+                continue
+            air = np.exp(1j * kz0 * (self.z_interfaces[0] - z_from)) * self._down_into(st, region)
+            top = self.top_of(region)
+            kz = st.kzs[region]
+            field = np.exp(1j * kz * (dz - top))
+            if region < self.n_regions - 1:
+                bottom = self.z_interfaces[region]
+                field = field + st.rho[region] * np.exp(1j * kz * (2 * bottom - top - dz))
+            out[sel] = air * field
+        return out
+
     def reflection(self, k: float, kappa2: np.ndarray) -> np.ndarray:
         """Reflection coefficient of the whole stack seen from the air at the surface.
 

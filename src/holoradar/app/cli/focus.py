@@ -1,0 +1,147 @@
+"""``holoradar autofocus``: the ground's permittivity from a buried object's focus."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import (
+    Reporter,
+    layout_option,
+    medium_from_options,
+    medium_options,
+    output_options,
+    read_hologram,
+)
+
+__all__ = ["COMMANDS"]
+
+
+def _pair(text: str, name: str) -> tuple[float, float]:
+    try:
+        a, b = (float(v) for v in text.split(","))
+    except ValueError:
+        raise click.BadParameter(f"expected two numbers MIN,MAX, got {text!r}",
+                                 param_hint=name) from None
+    return a, b
+
+
+@click.command()
+@click.argument("hologram_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@medium_options
+@click.option("--eps-range", default="1.5,16", show_default=True, metavar="MIN,MAX",
+              help="Ground permittivities eps' searched.")
+@click.option("--depth-range", default=None, metavar="MIN,MAX",
+              help="Depths below the surface where the object may lie, m (default: half a "
+                   "wavelength to 1.5 aperture widths, at least 0.5 m).")
+@click.option("--at", "position", default=None, metavar="X,Y",
+              help="Lateral position of the object to use, m (default: the brightest).")
+@click.option("--glare", "glare", is_flag=True,
+              help="The data still hold the surface glare: estimate eps' from it too, remove "
+                   "it and combine both estimates.")
+@click.option("--glare-estimate", default=None, metavar="EPS,SIGMA",
+              help="Combine with an eps' estimate made elsewhere and its 1-sigma.")
+@click.option("--fit", type=click.Choice(["field", "phase"]), default="field",
+              show_default=True, help="Match the complex field, or its phases only (for "
+                                      "arrays whose element amplitudes are not calibrated).")
+@click.option("--confidence", default=0.95, show_default=True,
+              type=click.FloatRange(0, 1, min_open=True, max_open=True))
+@click.option("--plot", "plot_file", default=None,
+              type=click.Path(dir_okay=False, path_type=Path),
+              help="Write a PNG of the residual against the trial eps'.")
+@click.option("--force", is_flag=True, help="Replace --plot if it exists.")
+@layout_option
+@output_options
+def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
+              depth_range: str | None, position: str | None, glare: bool,
+              glare_estimate: str | None, fit: str, confidence: float, plot_file: Path | None,
+              force: bool, layout: str | None, check: bool, report: Reporter) -> None:
+    """Find the ground permittivity that focuses a buried object best.
+
+    The ground is a half-space: --z-surface is its range from the array, --eps
+    the starting value (its loss tangent is kept; --tan-delta or --sigma set
+    the loss). Prints eps' with its confidence interval and the object's
+    position, or "not determinable" with the reason (exit code 0 either way).
+    """
+    from ...imaging.autofocus import autofocus as run
+    from ...io.output import check_output
+
+    eps_pair = _pair(eps_range, "--eps-range")
+    depth_pair = None if depth_range is None else _pair(depth_range, "--depth-range")
+    at = None if position is None else _pair(position, "--at")
+    if glare and glare_estimate:
+        raise click.BadParameter("give --glare or --glare-estimate, not both",
+                                 param_hint="--glare")
+    glare_arg: Any = True if glare else (_pair(glare_estimate, "--glare-estimate")
+                                         if glare_estimate else None)
+    if plot_file is not None:
+        check_output(plot_file, suffixes=[".png"], inputs=[hologram_file], overwrite=force,
+                     name="--plot")
+    holo = read_hologram(hologram_file, layout, check)
+    if medium_spec["eps"] is None and medium_spec["z_surface"] is not None:
+        medium_spec = {**medium_spec, "eps": "3"}  # only a start: eps' is what is sought
+    medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
+    if medium is None or medium.n_regions != 2:
+        raise click.BadParameter("autofocus needs a half-space ground: give --z-surface (and "
+                                 "optionally --eps as the start, --tan-delta or --sigma)",
+                                 param_hint="--z-surface")
+    res = run(holo, medium_model=medium, eps_range=eps_pair, depth_range=depth_pair,
+              position=at, glare=glare_arg, fit=fit, confidence=confidence,
+              progress=report.progress)
+    files = []
+    if plot_file is not None and res.eps_grid.size:
+        _plot(res, plot_file, hologram_file.name)
+        files.append(str(plot_file))
+    summary = {
+        "determinable": res.determinable, "eps": res.eps,
+        "eps_interval": res.eps_interval, "confidence": res.confidence,
+        "reason": res.reason, "position_m": res.position, "depth_m": res.depth,
+        "range_interval_m": res.range_interval, "eps_focus": res.eps_focus,
+        "eps_glare": res.eps_glare, "eps_glare_std": res.eps_glare_std,
+        "handle": res.handle, "focus_fraction": res.focus_fraction,
+        "evaluations": res.evaluations, "seconds": res.seconds, "files": files,
+    }
+    lines = [str(res)]
+    if res.position is not None:
+        x, y, z = res.position
+        lines.append(f"object at x={100 * x:.1f} y={100 * y:.1f} cm, range {100 * z:.1f} cm")
+    lines += [f"{res.eps_grid.size} trial eps', {res.evaluations} responses in "
+              f"{res.seconds:.1f} s", *[f"wrote {f}" for f in files]]
+    report.done(summary, lines)
+
+
+def _plot(res: Any, path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..atomic import write_atomic
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+    ax.semilogy(res.eps_grid, np.maximum(1 - res.profile, 1e-16), "o-", ms=3)
+    if res.eps_interval is not None:
+        ax.axvspan(*res.eps_interval, alpha=0.25,
+                   label=f"{100 * res.confidence:.0f}% interval: {res.eps_interval[0]:.3g} .. "
+                         f"{res.eps_interval[1]:.3g}")
+        ax.legend()
+    ax.set_xscale("log")
+    lo, hi = float(res.eps_grid.min()), float(res.eps_grid.max())
+    ticks = [t for t in (1, 1.5, 2, 3, 4, 6, 8, 10, 16, 20, 30, 50) if lo <= t <= hi]
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax.minorticks_off()
+    ax.set_xlabel("trial ground permittivity eps'")
+    ax.set_ylabel("residual energy / hologram energy (1 - F)")
+    ax.set_title(f"autofocus {title}: " + (f"eps' = {res.eps:.3g}" if res.determinable
+                                           else "not determinable"))
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120)
+    plt.close(fig)
+    write_atomic(path, buf.getvalue())
+
+
+COMMANDS = [autofocus]

@@ -1,0 +1,626 @@
+"""Autofocus: the ground permittivity that focuses a buried object best.
+
+The sharpness measure is the *focus fraction*: the share of the hologram's
+energy that one compact scatterer explains, the exact field of a point at
+``r`` in a ground of permittivity eps' (:mod:`.point_response`), fitted with its
+complex amplitude,
+
+    F(eps', r) = |<h, g>|^2 / (||g||^2 ||h||^2).
+
+It is the peak of the matched-filter image normalised, pixel by pixel, by the
+energy its point response leaves on the finite aperture. Image-domain measures
+(the peak, the normalised fourth moment, the entropy of a migrated image) are
+not normalised that way: a point's image through a finite aperture brightens
+and narrows as eps' grows (refraction squeezes more of its wave front onto the
+array), so they drift to high eps' (4.5 for a true 4.0 with the 16 x 16
+array). ``max F`` is the maximum-likelihood fit of one object in white noise,
+without that drift.
+
+Confidence interval: the profile likelihood. With ``R(eps') = ||h||^2 (1 -
+max_r F)`` the residual energy, the interval holds the eps' with
+``R - R_min <= z^2 * s^2 * phi``: ``z`` the normal quantile of the confidence,
+``s^2 = R_min / (2N - 6)`` the residual's variance per real component (N complex
+samples, six real parameters), and ``phi >= 1`` a sandwich correction for a
+residual that is not white (model error: a sphere is not a point, a vector field
+not a scalar one): ``phi = sum_k |D_k|^2 |R_k|^2 / (sigma^2 sum_k |D_k|^2)``, with
+``R_k`` the residual's spectrum and ``D_k`` that of the model's derivative with
+respect to eps' (made orthogonal to the derivatives in amplitude and position).
+It weighs the residual's power at the spatial frequencies (and delays) where
+eps' acts: 1 for white noise, more when the residual looks like a change of eps'.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import scipy.fft as sfft
+from scipy.optimize import brentq, least_squares, minimize_scalar
+from scipy.stats import norm
+from tqdm.auto import tqdm
+
+from .._validate import AliasingWarning
+from ..data.hologram import C0, Hologram
+from ..physics.medium import Medium
+from .migrate import migrate
+from .point_response import PointResponse
+
+__all__ = ["AutofocusResult", "autofocus"]
+
+_COARSE = 10          # eps' values of the first sweep (geometric)
+_FALSE_ALARM = 1e-3   # detection: chance that noise alone passes
+_MODEL_PRECISION = 1e-4  # relative amplitude accuracy of the model (quadrature, splines)
+
+
+@dataclass(frozen=True)
+class AutofocusResult:
+    """What :func:`autofocus` found.
+
+    Attributes
+    ----------
+    eps : float or None
+        Estimated real relative permittivity eps' of the ground (combined with the
+        glare's estimate when one was used); ``None`` when not determinable.
+    eps_interval : tuple of float or None
+        Its confidence interval (``confidence``).
+    determinable : bool
+        False when the data give no handle on eps' (then ``reason`` says why).
+    reason : str
+        Why not determinable, or how the estimate was made.
+    confidence : float
+    position : tuple of float or None
+        The object (x, y, z) at the estimate, metres (z the range from the
+        aperture).
+    range_interval : tuple of float or None
+        The object's range over ``eps_interval``, metres.
+    depth : float or None
+        The object's depth below the ground surface, metres.
+    eps_focus, eps_focus_interval
+        The focus's own estimate and interval (also when a glare was combined).
+    eps_glare, eps_glare_std
+        The glare's estimate and 1-sigma, when used.
+    focus_fraction : float
+        The share of the hologram's energy the object explains at the estimate.
+    detection : float
+        The object's matched-filter output over the residual noise level, and
+        ``detection_threshold`` the level noise alone exceeds with 1e-3 chance.
+    noise_inflation : float
+        The sandwich factor phi (1 for white residuals).
+    handle : str
+        What fixes eps': the wave front's shape (one frequency) or the delays too.
+    eps_grid, profile : ndarray
+        The eps' tried and the best focus fraction at each (sorted by eps').
+    evaluations : int
+        Point responses evaluated (the field of one trial object at every element
+        and frequency: the work of one trial).
+    integrals : int
+        Sommerfeld integrals computed (one per frequency, trial eps' and range;
+        each serves many trials).
+    seconds : float
+    medium : Medium or None
+        The ground model at the estimate.
+    """
+
+    eps: float | None
+    eps_interval: tuple[float, float] | None
+    determinable: bool
+    reason: str
+    confidence: float
+    position: tuple[float, float, float] | None = None
+    range_interval: tuple[float, float] | None = None
+    depth: float | None = None
+    eps_focus: float | None = None
+    eps_focus_interval: tuple[float, float] | None = None
+    eps_glare: float | None = None
+    eps_glare_std: float | None = None
+    focus_fraction: float = 0.0
+    detection: float = 0.0
+    detection_threshold: float = 0.0
+    noise_inflation: float = 1.0
+    handle: str = ""
+    eps_grid: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    profile: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    evaluations: int = 0
+    integrals: int = 0
+    seconds: float = 0.0
+    medium: Medium | None = field(default=None, repr=False)
+
+    @property
+    def std(self) -> float | None:
+        """Equivalent 1-sigma of eps' (half the interval over the normal quantile)."""
+        if self.eps_interval is None:
+            return None
+        return (self.eps_interval[1] - self.eps_interval[0]) / (2 * _quantile(self.confidence))
+
+    def __str__(self) -> str:
+        if not self.determinable:
+            return f"eps' not determinable: {self.reason}"
+        lo, hi = self.eps_interval
+        z = self.position[2]
+        return (f"eps' = {self.eps:.3g} ({100 * self.confidence:.0f}% interval {lo:.3g} .. "
+                f"{hi:.3g}); object at range {z:.4g} m, {self.depth:.4g} m below the surface "
+                f"({self.handle})")
+
+
+def _quantile(confidence: float) -> float:
+    return float(norm.ppf(0.5 + confidence / 2))
+
+
+def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Medium],
+              eps_range: tuple[float, float] = (1.5, 16.0),
+              depth_range: tuple[float, float] | None = None,
+              position: tuple[float, float] | None = None,
+              glare: bool | tuple[float, float] | None = None,
+              fit: Literal["field", "phase"] = "field", confidence: float = 0.95,
+              progress: bool = False) -> AutofocusResult:
+    """Find the ground permittivity eps' (and the object's range) that focuses best.
+
+    Fits one compact buried object: the exact field of a point scatterer in a
+    ground of trial permittivity (the model's Sommerfeld integral) is matched to
+    the hologram, its position and complex amplitude fitted, and eps' chosen to
+    maximise the focus fraction ``F = |<h, g>|^2 / (||g||^2 ||h||^2)`` (the
+    maximum-likelihood fit of one scatterer; see the module notes for why not
+    an image-sharpness metric). At one frequency only the wave front's shape
+    across the aperture carries eps' (a weak handle: the paraxial curvature
+    fixes ``z0 + depth/n`` alone, and the rest comes from the wider angles);
+    several frequencies add the two-way delay, ``z0 + n*depth`` (a strong one).
+
+    Parameters
+    ----------
+    hologram : Hologram
+        One frame, one or several frequencies, glare removed (or see ``glare``).
+        Across frequencies the data must be phase-calibrated, and a receiver
+        array needs its ``source`` (without it each frequency is fitted with its
+        own amplitude: the delay is lost). Tilted apertures are supported (slower).
+    medium_model : Medium or callable
+        The ground with eps' unknown: a half-space ``Medium`` (its surface range is
+        kept, and its loss tangent ``eps''/eps'``), or a function ``eps' ->
+        Medium`` for any other model (e.g. a known top layer over an unknown
+        ground).
+    eps_range : (float, float)
+        Range of eps' searched, default 1.5 .. 16.
+    depth_range : (float, float), optional
+        Depths below the surface to look for the object, metres; default from
+        half a wavelength in the ground to 1.5 aperture widths (at least 0.5 m).
+    position : (float, float), optional
+        Lateral (x, y) of the object to fit, metres; default the brightest one.
+    glare : bool or (float, float), optional
+        ``True``: the hologram still holds the surface glare; estimate eps' from it
+        (:func:`~holoradar.estimate_permittivity`), remove it and combine both
+        estimates by their inverse variances. ``(eps', sigma)``: combine with an
+        estimate made elsewhere. Default: no glare estimate.
+    confidence : float
+        Confidence of the interval, default 0.95.
+    progress : bool
+        Show a progress bar over the trial permittivities.
+
+    Returns
+    -------
+    AutofocusResult
+        ``eps`` with ``eps_interval``, the object's ``position`` and
+        ``range_interval``; or ``determinable=False`` and ``eps=None`` with the
+        ``reason`` when the scene gives no handle: no object above the noise, an
+        object at the surface or too shallow for the aperture, a best focus at the
+        edge of ``eps_range``, or an interval that reaches it.
+
+    Examples
+    --------
+    >>> import numpy as np, holoradar as hr
+    >>> truth = hr.Medium.half_space(0.30, 4.0)
+    >>> scene = hr.Scene(truth, hr.PlaneWave(), [hr.PointTarget((0.01, 0.0, 0.45))])
+    >>> h = hr.simulate(scene, hr.Aperture.paper(), 9.9e9, include_surface=False,
+    ...                 snr_db=40, seed=0)
+    >>> res = hr.autofocus(h, medium_model=hr.Medium.half_space(0.30, 3.0))
+    >>> res.determinable, res.eps_interval[0] < 4.0 < res.eps_interval[1]
+    (True, True)
+    >>> print(f"{res.eps:.1f}, {100 * res.depth:.0f} cm deep")
+    4.1, 15 cm deep
+    >>> noise = np.random.default_rng(1).standard_normal((16, 16, 2)) @ [1, 1j]
+    >>> res = hr.autofocus(hr.Hologram(noise, h.x, h.y, 9.9e9), medium_model=truth)
+    >>> print(res.eps, "-", res.reason.split(" (")[0])
+    None - no compact object stands out of the noise
+    """
+    t_start = time.perf_counter()
+    if not isinstance(hologram, Hologram):
+        raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
+    if hologram.data.ndim != (3 if hologram.is_wideband else 2):
+        raise ValueError("hologram: autofocus takes one frame (data (ny, nx) or (nf, ny, nx)), "
+                         f"got data of shape {hologram.data.shape}; pass one frame at a time")
+    if not np.any(hologram.data):
+        raise ValueError("hologram: every sample is zero; there is nothing to focus")
+    lo, hi = _check_range(eps_range)
+    make = _medium_factory(medium_model, lo, hi)
+    confidence = float(confidence)
+    if not 0 < confidence < 1:
+        raise ValueError(f"confidence must lie between 0 and 1 (e.g. 0.95), got {confidence}")
+    glare_est = None
+    if glare is True:
+        start = medium_model if isinstance(medium_model, Medium) else make(float(np.sqrt(lo * hi)))
+        hologram, glare_est = _glare_estimate(hologram, start)
+    elif glare not in (None, False):
+        glare_est = _check_glare(glare)
+    coherent = hologram.monostatic or hologram.nf == 1 or hologram.source is not None
+    handle = ("one frequency: the wave front's shape" if hologram.nf == 1 else
+              "several frequencies: the wave front's shape and the delay" if coherent else
+              "several frequencies without the illumination: the wave front's shape only")
+    if fit not in ("phase", "field"):
+        raise ValueError(f"fit must be 'phase' or 'field', got {fit!r}")
+    pr = PointResponse(hologram, make, coherent=coherent, phase_only=fit == "phase")
+    search = _Search(pr, make, lo, hi, hologram)
+    z0 = make(lo).z_interfaces[0]
+    base = dict(confidence=confidence, handle=handle, eps_glare=None if glare_est is None
+                else glare_est[0], eps_glare_std=None if glare_est is None else glare_est[1])
+
+    def finish(**kw: Any) -> AutofocusResult:
+        grid = np.array(sorted(search.best))
+        prof = np.array([search.best[e][0] for e in grid])
+        kw = {**base, **kw}
+        if not kw.get("determinable", True) and glare_est is not None:
+            g, s = glare_est
+            q = _quantile(confidence)
+            kw.update(eps=g, eps_interval=(g - q * s, g + q * s), determinable=True,
+                      reason=f"from the glare alone (the focus gave no handle: {kw['reason']})",
+                      medium=make(g))
+        return AutofocusResult(eps_grid=grid, profile=prof, evaluations=pr.responses,
+                               integrals=pr.integrals,
+                               seconds=time.perf_counter() - t_start, **kw)
+
+    # 1. Where is the object? The brightest voxel of a migrated image.
+    located = search.locate(depth_range, position, z0)
+    if located is None:
+        return finish(eps=None, eps_interval=None, determinable=False,
+                      reason="the brightest focus lies at the ground surface or above it, not "
+                             "in the ground")
+    # 2. Is there an object at all? Fit one at a middle eps' and test it against noise.
+    grid = np.geomspace(lo, hi, _COARSE)
+    mid = float(grid[len(grid) // 2])
+    _, z_mid, xy_mid = search.evaluate(mid)
+    pre = search.statistics(mid, z_mid, xy_mid)
+    if pre["detection"] < pre["threshold"]:
+        return finish(eps=None, eps_interval=None, determinable=False,
+                      reason=_no_object(pre), position=(float(xy_mid[0]), float(xy_mid[1]),
+                                                        float(z_mid)),
+                      detection=pre["detection"], detection_threshold=pre["threshold"])
+    # 3. Coarse sweep of eps' outwards from there, each with its best range and position.
+    order = sorted(grid, key=lambda e: abs(np.log(e / mid)))
+    for e in tqdm(order, desc="autofocus", unit="eps", disable=not progress, delay=1.0):
+        search.evaluate(float(e))
+    i = int(np.argmax([search.best[float(e)][0] for e in grid]))
+    e_hat = float(grid[i])
+    if 0 < i < len(grid) - 1:
+        opt = minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
+                              bounds=(np.log(grid[i - 1]), np.log(grid[i + 1])),
+                              method="bounded", options={"xatol": 1e-3})
+        e_hat = float(np.exp(opt.x))
+        search.evaluate(e_hat)
+        e_hat = max(search.best, key=lambda e: search.best[e][0])
+    F_max, z_hat, xy_hat = search.best[e_hat]
+    # 4. Noise level, detection and the sandwich factor at the optimum.
+    stats = search.statistics(e_hat, z_hat, xy_hat)
+    pos = (float(xy_hat[0]), float(xy_hat[1]), float(z_hat))
+    common = dict(position=pos, depth=float(z_hat - z0), focus_fraction=F_max,
+                  detection=stats["detection"], detection_threshold=stats["threshold"],
+                  noise_inflation=stats["phi"])
+    if stats["detection"] < stats["threshold"]:
+        return finish(eps=None, eps_interval=None, determinable=False,
+                      reason=_no_object(stats), **common)
+    if e_hat <= grid[0] * (1 + 1e-9) or e_hat >= grid[-1] * (1 - 1e-9):
+        return finish(eps=None, eps_interval=None, determinable=False,
+                      reason=f"the sharpest focus lies at the edge of eps_range ({lo:g} .. "
+                             f"{hi:g}): widen it, or the scene gives no handle", **common)
+    # 5. Profile-likelihood interval: R(eps) - R_min <= q^2 s^2 phi, in focus-fraction units.
+    # The statistical part (noise, q s sqrt(phi)) and a bound on the bias a smooth model
+    # error of energy E_err can cause, were it aligned with the change of eps' (profile
+    # residual rises as ||d||^2 delta^2, the bias is at most sqrt(E_err)/||d||): the
+    # deviations add, so their square roots do.
+    q = _quantile(confidence)
+    drop = (q * np.sqrt(stats["s2"] * stats["phi"]) + np.sqrt(stats["model_error"])) ** 2 \
+        / (stats["residual_scale"] * pr.energy)
+    ends = []
+    for side in (-1, 1):
+        end = search.crossing(e_hat, F_max - drop, side)
+        if end is None:
+            return finish(eps=None, eps_interval=None, determinable=False,
+                          reason=f"the focus hardly changes with eps': its {100 * confidence:.0f}%"
+                                 f" interval reaches the edge of eps_range ({lo:g} .. {hi:g}) "
+                                 "(object too shallow, or too small an aperture for one "
+                                 "frequency)", **common)
+        ends.append(end)
+    interval = (ends[0], ends[1])
+    r_int = tuple(sorted((search.best[ends[0]][1], search.best[ends[1]][1])))
+    est, est_int = e_hat, interval
+    reason = "from the focus"
+    if glare_est is not None:
+        est, est_int, reason = _combine(e_hat, interval, glare_est, q)
+    return finish(eps=float(est), eps_interval=est_int, determinable=True, reason=reason,
+                  range_interval=(float(r_int[0]), float(r_int[1])), eps_focus=e_hat,
+                  eps_focus_interval=interval, medium=make(float(est)), **common)
+
+
+class _Search:
+    """The best focus for each trial eps': range by a polynomial fit, lateral by simplex."""
+
+    def __init__(self, pr: PointResponse, make: Callable[[float], Medium], lo: float, hi: float,
+                 hologram: Hologram) -> None:
+        self.pr, self.make, self.lo, self.hi = pr, make, lo, hi
+        self.hologram = hologram
+        self.lam = C0 / float(np.mean(hologram.frequencies))
+        self.best: dict[float, tuple[float, float, np.ndarray]] = {}
+        self.A = self.P = 0.0
+        self.xy = np.zeros(2)
+        f = hologram.frequencies
+        self.wideband = f.size > 1 and pr.coherent
+        self.band = float(f.max() - f.min()) if f.size > 1 else 0.0
+        self.z0 = 0.0
+        self.trials = 1
+
+    def locate(self, depth_range: tuple[float, float] | None, position: Any,
+               z0: float) -> bool | None:
+        h = self.hologram
+        e_mid = float(np.sqrt(self.lo * self.hi))
+        m = self.make(e_mid)
+        lam_m = C0 / float(h.frequencies.max()) / np.sqrt(e_mid)
+        if depth_range is None:
+            size = float(max(np.ptp(h.x), np.ptp(h.y)))
+            depth_range = (lam_m / 2, max(0.5, 1.5 * size))
+        d0, d1 = (float(v) for v in depth_range)
+        if not (np.isfinite(d0) and np.isfinite(d1) and 0 <= d0 < d1):
+            raise ValueError(f"depth_range must be (min, max) depths in metres with 0 <= min < "
+                             f"max, got {depth_range!r}")
+        zs = z0 + np.arange(max(d0, 1e-4), d1 + lam_m / 2, lam_m / 2)
+        self.trials = zs.size * h.data.shape[-1] * h.data.shape[-2]
+        combine = "coherent" if self.pr.coherent else "incoherent"
+        with warnings.catch_warnings():  # only the brightest voxel is wanted here
+            warnings.simplefilter("ignore", AliasingWarning)
+            img = migrate(h, zs, medium=m, combine=combine, progress=False)
+        a = np.abs(img.data)
+        if position is not None:
+            try:
+                px, py = (float(v) for v in position)
+            except (TypeError, ValueError):
+                raise ValueError(f"position must be (x, y) in metres, got {position!r}") from None
+            ix, iy = int(np.argmin(abs(img.x - px))), int(np.argmin(abs(img.y - py)))
+            iz = int(np.argmax(a[:, iy, ix]))
+        else:
+            iz, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
+        self.z0 = z0
+        self.xy = np.array([img.x[ix], img.y[iy]], float)
+        zp = float(zs[iz])
+        self.A = m.apparent_distance(zp)
+        self.P = m.optical_path(zp).real
+        if zp <= z0 + lam_m / 4:
+            return None
+        return True
+
+    def delay_range(self, eps: float) -> float:
+        """Range whose normal-incidence optical path is the located one."""
+        m = self.make(eps)
+        top = self.z0 + (self.P - self.z0) * 2 + 1e-3
+        return float(brentq(lambda z: m.optical_path(z).real - self.P, self.z0, top))
+
+    def paraxial_range(self, eps: float) -> float:
+        """Range whose paraxial apparent distance is the located one."""
+        m = self.make(eps)
+        top = self.z0 + (self.A - self.z0) * np.sqrt(max(abs(e) for e in m.eps)) * 2 + 1e-3
+        return float(brentq(lambda z: m.apparent_distance(z) - self.A, self.z0, top))
+
+    def evaluate(self, eps: float) -> tuple[float, float, np.ndarray]:
+        """Best focus fraction at ``eps`` with its range and lateral position.
+
+        Gauss-Newton (Levenberg-Marquardt) on the residual ``h - a g`` with the
+        amplitude ``a`` projected out, from the paraxially equivalent range.
+        """
+        if eps in self.best:
+            return self.best[eps]
+        pr = self.pr
+        floor = self.z0 + pr.spacing(eps) / 4
+        offset, xy0 = 0.0, self.xy
+        if self.best:  # start from the fit at the nearest eps' tried (a continuous path)
+            near = min(self.best, key=lambda e: abs(np.log(e / eps)))
+            _, z_near, xy0 = self.best[near]
+            offset = z_near - self.paraxial_range(near)
+        # The object's range for this eps': near the range of the same paraxial curvature
+        # (one frequency) or between it and the range of the same delay (several).
+        z_c = self.paraxial_range(eps) + offset
+        lam_m = self.lam / np.sqrt(eps)
+        ends = [z_c - lam_m / 2, z_c + lam_m / 2]
+        if self.wideband:
+            z_d = self.delay_range(eps)
+            res = C0 / (2 * self.band * np.sqrt(eps))  # range resolution in the ground
+            ends = [min(z_c, z_d) - max(res, lam_m), max(z_c, z_d) + max(res, lam_m)]
+        z_start, _ = pr.scan(eps, max(ends[0], floor), max(ends[1], floor + lam_m), xy0)
+        p0 = np.array([xy0[0], xy0[1], z_start])
+
+        def resid(p: np.ndarray) -> np.ndarray:
+            r, _, _ = pr.residual(eps, max(p[2], floor), p[:2])
+            return np.concatenate([r.real.ravel(), r.imag.ravel()])
+
+        sol = least_squares(resid, p0, method="lm", xtol=1e-12, ftol=1e-15, gtol=1e-15,
+                            x_scale=np.full(3, self.lam / 10))
+        p = sol.x
+        z = max(float(p[2]), floor)
+        xy = np.clip(p[:2], *pr.bounds)
+        F = pr.focus(eps, z, xy)
+        self.best[eps] = (F, z, xy)
+        return self.best[eps]
+
+    def crossing(self, e_hat: float, level: float, side: int) -> float | None:
+        """eps' on ``side`` of ``e_hat`` where the best focus fraction falls to ``level``."""
+        inside = e_hat
+        for e in sorted(self.best, reverse=side < 0):
+            if (e - e_hat) * side > 0 and self.best[e][0] < level:
+                outside = e
+                break
+            if (e - e_hat) * side > 0:
+                inside = e
+        else:
+            edge = self.lo if side < 0 else self.hi
+            if self.evaluate(edge)[0] >= level:
+                return None
+            outside = edge
+
+        def f(e: float) -> float:
+            return self.evaluate(float(e))[0] - level
+
+        return float(brentq(f, inside, outside, rtol=1e-3))
+
+    def statistics(self, eps: float, z: float, xy: np.ndarray) -> dict[str, float]:
+        """Noise variance, detection statistic and sandwich factor at the optimum."""
+        pr = self.pr
+        n_amp = 1 if pr.coherent else pr.h.shape[0]
+        n_complex = pr.h.size
+        floor = (_MODEL_PRECISION ** 2) * pr.energy / (2 * n_complex)
+        # Detection, from the complex-field fit: the matched filter's output over the
+        # complex noise variance 2 s^2 is exponential for noise alone; its largest value
+        # over the trials is ~ log(trials).
+        rf, gf, _ = pr.residual(eps, z, xy, phase=False)
+        s2f = max(float(np.vdot(rf, rf).real) / max(2 * n_complex - 4 - 2 * n_amp, 1), floor)
+        detection = pr.energy * pr.match(gf, phase=False)[0] / (2 * s2f)
+        threshold = float(np.log(self.trials / _FALSE_ALARM))
+        # Residual variance per real component: a phase-only residual has one real
+        # component per sample (along the phase), a field residual two.
+        r, g, a = pr.residual(eps, z, xy)
+        R = float(np.vdot(r, r).real)
+        dof = (n_complex if pr.phase_only else 2 * n_complex) - 4 - (1 if pr.phase_only else 2) \
+            * n_amp
+        s2 = max(R / max(dof, 1), floor)
+
+        def model(e: float, zz: float, p: np.ndarray) -> np.ndarray:
+            return pr.model(pr.response(e, zz, p), a)
+
+        # Sandwich: tangent vectors of the model in (amplitude, x, y, z) and eps'.
+        de, dz, dx = 1e-3 * eps, self.lam / np.sqrt(eps) / 40, self.lam / 400
+        m0 = pr.model(g, a)
+        d_eps = (model(eps + de, z, xy) - model(eps - de, z, xy)) / (2 * de)
+        groups = [np.ones(m0.shape[0], bool)] if pr.coherent else \
+            [np.arange(m0.shape[0]) == f for f in range(m0.shape[0])]
+        tangents = []
+        for sel in groups:  # each amplitude: its phase, and for a field fit its modulus
+            t = np.where(sel[:, None], m0, 0)
+            tangents += [1j * t] if pr.phase_only else [t, 1j * t]
+        for dv in (np.array([dx, 0]), np.array([0, dx])):
+            tangents.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * dx))
+        tangents.append((model(eps, z + dz, xy) - model(eps, z - dz, xy)) / (2 * dz))
+        T = np.stack([np.concatenate([t.real.ravel(), t.imag.ravel()]) for t in tangents], 1)
+        d = np.concatenate([d_eps.real.ravel(), d_eps.imag.ravel()])
+        coef, *_ = np.linalg.lstsq(T, d, rcond=None)
+        dp = d - T @ coef
+        d_perp = (dp[:d.size // 2] + 1j * dp[d.size // 2:]).reshape(self.hologram.data.shape)
+        D = np.abs(sfft.fftn(d_perp, norm="ortho")) ** 2
+        Rk = np.abs(sfft.fftn(r.reshape(self.hologram.data.shape), norm="ortho")) ** 2
+        # White residual: E|R_k|^2 = (real components per sample) * s^2.
+        per = 1 if pr.phase_only else 2
+        phi = float(np.sum(D * Rk) / (per * s2 * np.sum(D))) if np.sum(D) > 0 else 1.0
+        return dict(s2=s2, detection=float(detection), threshold=threshold,
+                    phi=max(1.0, phi), residual_scale=2.0 if pr.phase_only else 1.0,
+                    model_error=_correlated_energy(r.reshape(self.hologram.data.shape)))
+
+
+def _correlated_energy(r: np.ndarray) -> float:
+    """Energy of the part of a residual that is smooth from element to element.
+
+    Receiver noise is white: neighbouring elements' residuals are uncorrelated. A
+    model error (an object that is not a point, a vector field, an inexact ground)
+    varies smoothly across the aperture, so the lag-one autocovariance ``C1`` of
+    the residual measures its power: the energy ``sum |r|^2 * |C1|/C0``, counted
+    only when ``|C1|/C0`` exceeds three times its spread for white noise
+    (``1/sqrt(pairs)``).
+    """
+    c0 = float(np.mean(np.abs(r) ** 2))
+    if c0 == 0:
+        return 0.0
+    pairs = [(r[..., :, 1:], r[..., :, :-1]), (r[..., 1:, :], r[..., :-1, :])]
+    n = sum(a.size for a, _ in pairs)
+    c1 = sum(np.vdot(b, a) for a, b in pairs) / n
+    rho = min(1.0, abs(c1) / c0)
+    if rho < 3 / np.sqrt(n):
+        return 0.0
+    return float(rho * np.sum(np.abs(r) ** 2))
+
+
+def _no_object(stats: dict[str, float]) -> str:
+    return (f"no compact object stands out of the noise (matched filter "
+            f"{stats['detection']:.3g} x the noise level; noise alone reaches "
+            f"{stats['threshold']:.3g})")
+
+
+def _check_range(eps_range: Any) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in eps_range)
+    except (TypeError, ValueError):
+        raise ValueError(f"eps_range must be (min, max) real permittivities, got "
+                         f"{eps_range!r}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi) and 1 <= lo < hi):
+        raise ValueError(f"eps_range must satisfy 1 <= min < max (real eps'), got {eps_range!r}")
+    return lo, hi
+
+
+def _medium_factory(model: Any, lo: float, hi: float) -> Callable[[float], Medium]:
+    if isinstance(model, Medium):
+        if model.n_regions != 2:
+            raise ValueError("medium_model: a Medium must be a half-space (its ground's eps' is "
+                             f"what autofocus finds); this one has {model.n_regions - 1} ground "
+                             "layers: pass a function eps' -> Medium that says which one varies")
+        z0, e = model.z_interfaces[0], complex(model.eps[1])
+        tan = e.imag / e.real if e.real > 0 else 0.0
+
+        def make(eps: float) -> Medium:
+            return Medium((z0,), (1.0, complex(eps, eps * tan)), model.polarization)
+
+        return make
+    if not callable(model):
+        raise ValueError("medium_model must be a half-space Medium or a function eps' -> Medium, "
+                         f"got {type(model).__name__}")
+
+    def checked(eps: float) -> Medium:
+        m = model(eps)
+        if not isinstance(m, Medium) or m.is_free_space:
+            raise ValueError(f"medium_model({eps:g}) must return a Medium with a ground, got "
+                             f"{m!r}")
+        return m
+
+    surfaces = {checked(lo).z_interfaces[0], checked(hi).z_interfaces[0]}
+    if len(surfaces) != 1:
+        raise ValueError("medium_model must keep the ground surface at one range for every eps' "
+                         f"(got {sorted(surfaces)} m)")
+    return checked
+
+
+def _check_glare(glare: Any) -> tuple[float, float]:
+    try:
+        g, s = (float(v) for v in glare)
+    except (TypeError, ValueError):
+        raise ValueError("glare must be True, None, or (eps', sigma) of an independent "
+                         f"estimate, got {glare!r}") from None
+    if not (np.isfinite(g) and g >= 1 and np.isfinite(s) and s > 0):
+        raise ValueError(f"glare = (eps', sigma) needs eps' >= 1 and sigma > 0, got {glare!r}")
+    return g, s
+
+
+def _glare_estimate(hologram: Hologram, medium: Medium) -> tuple[Hologram, tuple[float, float]]:
+    from .reflection import suppress_surface
+
+    if hologram.monostatic or hologram.source is None or hologram.is_wideband:
+        raise ValueError("glare=True needs a single-frequency receiver-array hologram with its "
+                         "source (the glare is the source's reflection); remove the glare "
+                         "yourself and pass glare=(eps', sigma), or glare=None")
+    clean, rep = suppress_surface(hologram, medium, None, "image_source")
+    return clean, (float(rep.eps.real), float(rep.eps_std[0]))
+
+
+def _combine(e_f: float, interval: tuple[float, float], glare: tuple[float, float],
+             q: float) -> tuple[float, tuple[float, float], str]:
+    s_f = (interval[1] - interval[0]) / (2 * q)
+    e_g, s_g = glare
+    w_f, w_g = 1 / s_f**2, 1 / s_g**2
+    est = (w_f * e_f + w_g * e_g) / (w_f + w_g)
+    s = 1 / np.sqrt(w_f + w_g)
+    gap = abs(e_f - e_g) / np.hypot(s_f, s_g)
+    note = ("focus and glare combined by inverse variance" if gap < 3 else
+            f"focus and glare combined, but they disagree by {gap:.1f} sigma: the glare sees the "
+            "top of the ground, the focus the path down to the object (layered ground?)")
+    return float(est), (float(est - q * s), float(est + q * s)), note
