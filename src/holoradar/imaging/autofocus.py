@@ -289,15 +289,27 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     order = sorted(grid, key=lambda e: abs(np.log(e / mid)))
     for e in tqdm(order, desc="autofocus", unit="eps", disable=not progress, delay=1.0):
         search.evaluate(float(e))
-    i = int(np.argmax([search.best[float(e)][0] for e in grid]))
-    e_hat = float(grid[i])
-    if 0 < i < len(grid) - 1:
+    # Local maxima of the sweep, and (several frequencies) every eps' where curvature and
+    # an alias of the delay agree: each refined, the best kept, the others checked below.
+    F_grid = [search.best[float(e)][0] for e in grid]
+    seeds = [(float(grid[j - 1]) if j else lo, float(grid[j]),
+              float(grid[j + 1]) if j < len(grid) - 1 else hi)
+             for j in range(len(grid)) if (j == 0 or F_grid[j] >= F_grid[j - 1])
+             and (j == len(grid) - 1 or F_grid[j] >= F_grid[j + 1])]
+    seeds += [(max(lo, c / 1.03), c, min(hi, c * 1.03)) for c in search.candidates()]
+    modes = []
+    for a, c, b in seeds:
+        if c in (lo, hi) or not a < c < b:
+            modes.append(c)
+            search.evaluate(c)
+            continue
         opt = minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
-                              bounds=(np.log(grid[i - 1]), np.log(grid[i + 1])),
-                              method="bounded", options={"xatol": 1e-3})
-        e_hat = float(np.exp(opt.x))
-        search.evaluate(e_hat)
-        e_hat = max(search.best, key=lambda e: search.best[e][0])
+                              bounds=(np.log(a), np.log(b)), method="bounded",
+                              options={"xatol": 1e-3})
+        modes.append(max((e for e in search.best if a <= e <= b),
+                         key=lambda e: search.best[e][0]))
+        del opt
+    e_hat = max(search.best, key=lambda e: search.best[e][0])
     F_max, z_hat, xy_hat = search.best[e_hat]
     # 4. Noise level, detection and the sandwich factor at the optimum.
     stats = search.statistics(e_hat, z_hat, xy_hat)
@@ -308,7 +320,7 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     if stats["detection"] < stats["threshold"]:
         return finish(eps=None, eps_interval=None, determinable=False,
                       reason=_no_object(stats), **common)
-    if e_hat <= grid[0] * (1 + 1e-9) or e_hat >= grid[-1] * (1 - 1e-9):
+    if e_hat <= lo * (1 + 1e-9) or e_hat >= hi * (1 - 1e-9):
         return finish(eps=None, eps_interval=None, determinable=False,
                       reason=f"the sharpest focus lies at the edge of eps_range ({lo:g} .. "
                              f"{hi:g}): widen it, or the scene gives no handle", **common)
@@ -331,6 +343,18 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
                                  "frequency)", **common)
         ends.append(end)
     interval = (ends[0], ends[1])
+    rivals = sorted({round(e, 3) for e in modes if not interval[0] <= e <= interval[1]
+                     and search.best[e][0] >= F_max - drop})
+    if rivals:
+        note = ""
+        if search.wideband:
+            df = float(np.min(np.diff(hologram.frequencies)))
+            note = (f"; the frequency step {df / 1e6:.0f} MHz leaves the delay ambiguous by "
+                    f"c/(2 df) = {100 * C0 / (2 * df):.1f} cm of optical path: use finer steps")
+        return finish(eps=None, eps_interval=None, determinable=False,
+                      reason=f"ambiguous: eps' = {e_hat:.3g} and "
+                             f"{', '.join(f'{e:.3g}' for e in rivals)} focus equally well{note}",
+                      **common)
     r_int = tuple(sorted((search.best[ends[0]][1], search.best[ends[1]][1])))
     est, est_int = e_hat, interval
     reason = "from the focus"
@@ -351,6 +375,7 @@ class _Search:
         self.lam = C0 / float(np.mean(hologram.frequencies))
         self.best: dict[float, tuple[float, float, np.ndarray]] = {}
         self.A = self.P = 0.0
+        self.depths = (0.0, 0.0)
         self.xy = np.zeros(2)
         f = hologram.frequencies
         self.wideband = f.size > 1 and pr.coherent
@@ -376,7 +401,9 @@ class _Search:
         combine = "coherent" if self.pr.coherent else "incoherent"
         with warnings.catch_warnings():  # only the brightest voxel is wanted here
             warnings.simplefilter("ignore", AliasingWarning)
-            img = migrate(h, zs, medium=m, combine=combine, progress=False)
+            # A moved or tilted aperture: image on the ground's own (world) planes.
+            frame = "aperture" if h.pose.is_identity else "ground"
+            img = migrate(h, zs, medium=m, combine=combine, progress=False, frame=frame)
         a = np.abs(img.data)
         if position is not None:
             try:
@@ -384,23 +411,63 @@ class _Search:
             except (TypeError, ValueError):
                 raise ValueError(f"position must be (x, y) in metres, got {position!r}") from None
             ix, iy = int(np.argmin(abs(img.x - px))), int(np.argmin(abs(img.y - py)))
-            iz = int(np.argmax(a[:, iy, ix]))
         else:
-            iz, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
+            _, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
         self.z0 = z0
         self.xy = np.array([img.x[ix], img.y[iy]], float)
-        zp = float(zs[iz])
-        self.A = m.apparent_distance(zp)
+        # The object's range from the point fit itself along that column: an image's
+        # brightest plane may sit far off (a wide depth of focus, aliasing, brighter
+        # shallow planes); a point's response matches only near its own range.
+        # Curvature (each frequency its own amplitude) and, across frequencies, delay.
+        top, bottom = z0 + max(d0, 1e-4), z0 + d1
+        z_a, _ = self.pr.scan(e_mid, top, bottom, self.xy, coherent=False,
+                              samples=int(np.clip((d1 - d0) / (lam_m / 2), 24, 240)))
+        self.A = m.apparent_distance(z_a)
+        zp = z_a
+        if self.wideband:
+            res = C0 / (2 * self.band * np.sqrt(e_mid))
+            zp, _ = self.pr.scan(e_mid, top, bottom, self.xy,
+                                 samples=int(np.clip((d1 - d0) / (res / 3), 24, 240)))
         self.P = m.optical_path(zp).real
-        if zp <= z0 + lam_m / 4:
+        self.depths = (top, bottom)
+        if zp <= z0 + lam_m / 4 or z_a <= z0 + lam_m / 4:
             return None
         return True
 
-    def delay_range(self, eps: float) -> float:
-        """Range whose normal-incidence optical path is the located one."""
+    def candidates(self) -> list[float]:
+        """eps' where curvature and delay agree (half-space, paraxial), for every alias
+        of the delay: uniformly spaced frequencies fix the optical path only modulo
+        ``c/(2 df)``, so ``n^2 = (P + m c/(2 df) - z0)/(A - z0)`` for each integer m."""
+        if not self.wideband or self.A <= self.z0:
+            return []
+        step = float(np.min(np.diff(self.hologram.frequencies)))
+        alias = C0 / (2 * step)
+        out = []
+        for m in range(-50, 51):
+            e = (self.P + m * alias - self.z0) / (self.A - self.z0)
+            if self.lo < e < self.hi:
+                out.append(float(e))
+        return out
+
+    def delay_ranges(self, eps: float) -> list[float]:
+        """Ranges whose normal-incidence optical path is the located one, or one of its
+        aliases ``P + m c/(2 df)`` (uniformly stepped frequencies)."""
         m = self.make(eps)
-        top = self.z0 + (self.P - self.z0) * 2 + 1e-3
-        return float(brentq(lambda z: m.optical_path(z).real - self.P, self.z0, top))
+        step = float(np.min(np.diff(self.hologram.frequencies)))
+        alias = C0 / (2 * step)
+        out = []
+        for k in range(-50, 51):
+            P = self.P + k * alias
+            if P <= self.z0:
+                continue
+            top = self.z0 + (P - self.z0) * 2 + 1e-3
+            if m.optical_path(top).real < P or m.optical_path(self.z0).real > P:
+                continue
+            z = float(brentq(lambda z, P=P: m.optical_path(z).real - P, self.z0, top))
+            if z > self.depths[1] + alias:
+                break
+            out.append(z)
+        return out
 
     def paraxial_range(self, eps: float) -> float:
         """Range whose paraxial apparent distance is the located one."""
@@ -429,18 +496,30 @@ class _Search:
         lam_m = self.lam / np.sqrt(eps)
         ends = [z_c - lam_m / 2, z_c + lam_m / 2]
         if self.wideband:
-            z_d = self.delay_range(eps)
+            # Around the paraxial range and every alias of the delay within the depths
+            # searched (the best may be any), finely: the focus peaks over about half the
+            # range resolution.
             res = C0 / (2 * self.band * np.sqrt(eps))  # range resolution in the ground
-            ends = [min(z_c, z_d) - max(res, lam_m), max(z_c, z_d) + max(res, lam_m)]
-        z_start, _ = pr.scan(eps, max(ends[0], floor), max(ends[1], floor + lam_m), xy0)
+            centres = [z for z in (z_c, *self.delay_ranges(eps))
+                       if self.depths[0] - res <= z <= self.depths[1] + res]
+            z_start, _ = max((pr.scan(eps, max(c - res, floor), max(c + res, floor + lam_m),
+                                      xy0, samples=17) for c in centres),
+                             key=lambda t: t[1])
+        else:
+            z_start, _ = pr.scan(eps, max(ends[0], floor), max(ends[1], floor + lam_m), xy0)
         p0 = np.array([xy0[0], xy0[1], z_start])
 
         def resid(p: np.ndarray) -> np.ndarray:
             r, _, _ = pr.residual(eps, max(p[2], floor), p[:2])
             return np.concatenate([r.real.ravel(), r.imag.ravel()])
 
-        sol = least_squares(resid, p0, method="lm", xtol=1e-12, ftol=1e-15, gtol=1e-15,
-                            x_scale=np.full(3, self.lam / 10))
+        # Bounded to the scanned peak's basin: an unbounded first step may jump to another
+        # alias of the delay.
+        reach = C0 / (4 * self.band * np.sqrt(eps)) if self.wideband else 2 * lam_m
+        lo_b = np.array([*(p0[:2] - 2 * lam_m), max(p0[2] - reach, floor)])
+        hi_b = np.array([*(p0[:2] + 2 * lam_m), p0[2] + reach])
+        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-12,
+                            ftol=1e-15, gtol=1e-15, x_scale=np.full(3, self.lam / 10))
         p = sol.x
         z = max(float(p[2]), floor)
         xy = np.clip(p[:2], *pr.bounds)

@@ -116,24 +116,28 @@ class PointResponse:
         """Range spacing of the windows at ``eps`` (lambda/8 in the ground), metres."""
         return 2 * np.pi / (self.ks.max() * np.sqrt(max(eps, 1.0))) / _Z_STEPS
 
-    def scan(self, eps: float, z_lo: float, z_hi: float, xy: Any) -> tuple[float, float]:
+    def scan(self, eps: float, z_lo: float, z_hi: float, xy: Any, *, samples: int = 24,
+             coherent: bool | None = None) -> tuple[float, float]:
         """Range in [z_lo, z_hi] with the best focus at ``xy``, and that focus fraction.
 
-        Sampled at :meth:`spacing`, or in 24 steps when that is finer (a wide search
-        only needs a start: the fit then refines the range on a fine window).
+        Sampled at :meth:`spacing`, or in ``samples`` steps when that is finer (a wide
+        search only needs a start: the fit then refines the range on a fine window).
         """
         n = int(np.ceil((z_hi - z_lo) / self.spacing(eps)))
+        def f(z: float, w: _Window | None = None) -> float:
+            return self.match(self.response(eps, z, xy, window=w), coherent=coherent)[0]
+
         if not self.flat:
-            zs = np.linspace(z_lo, z_hi, max(n, 2))
-            F = [self.focus(eps, z, xy) for z in zs]
+            zs = np.linspace(z_lo, z_hi, max(min(n, samples), 2))
+            F = [f(z) for z in zs]
         elif n <= 2 * _Z_HALF:
             w = self._window(float(eps), 0.5 * (z_lo + z_hi), z_hi - z_lo)
             zs = w.zs[1:-2]
-            F = [self.focus(eps, z, xy) for z in zs]
+            F = [f(z) for z in zs]
         else:
-            zs = np.linspace(z_lo, z_hi, 24)
+            zs = np.linspace(z_lo, z_hi, samples)
             w = self._compute(float(eps), zs)  # coarse: evaluated at its nodes only
-            F = [self.match(self.response(eps, z, xy, window=w))[0] for z in zs]
+            F = [f(z, w) for z in zs]
         i = int(np.argmax(F))
         return float(zs[i]), float(F[i])
 
@@ -213,7 +217,8 @@ class PointResponse:
         return G * E0[:, None]
 
     # ------------------------------------------------------------- matching
-    def match(self, g: np.ndarray, *, phase: bool | None = None) -> tuple[float, np.ndarray]:
+    def match(self, g: np.ndarray, *, phase: bool | None = None,
+              coherent: bool | None = None) -> tuple[float, np.ndarray]:
         """Focus fraction of ``g`` and the fitted amplitude(s) (one per frequency).
 
         Phase-only (``phase=True``, default :attr:`phase_only`): the model is the data's
@@ -221,10 +226,11 @@ class PointResponse:
         ``F = |sum |h|^2 exp(i(arg h - arg g))| / sum |h|^2`` and the residual energy
         ``2 ||h||^2 (1 - F)``.
         """
+        coherent = self.coherent if coherent is None else coherent
         if self.phase_only if phase is None else phase:
             u = self.h * np.abs(self.h) * np.exp(-1j * np.angle(g))
             c = u.sum(axis=1)
-            if self.coherent:
+            if coherent:
                 c_all = c.sum()
                 a = c_all / abs(c_all) if c_all else 1.0
                 return float(abs(c_all) / self.energy), np.full(len(c), a)
@@ -232,7 +238,7 @@ class PointResponse:
             return float(np.abs(c).sum() / self.energy), a
         c = np.einsum("fe,fe->f", g.conj(), self.h)
         n = np.einsum("fe,fe->f", g.conj(), g).real
-        if self.coherent:
+        if coherent:
             a = c.sum() / n.sum()
             return float(abs(c.sum()) ** 2 / n.sum() / self.energy), np.full(len(c), a)
         return float(np.sum(np.abs(c) ** 2 / n) / self.energy), c / n

@@ -28,6 +28,7 @@ tests).
 from __future__ import annotations
 
 import functools
+import hashlib
 import itertools
 from typing import Literal
 
@@ -278,6 +279,25 @@ def _reflected(k: float, medium: Medium, rho: np.ndarray, air_path: np.ndarray) 
     return out
 
 
+_J0_CACHE: dict[bytes, np.ndarray] = {}
+_J0_CACHE_BYTES = 256 * 2**20
+
+
+def _bessel_matrix(rho: np.ndarray, kappa: np.ndarray) -> np.ndarray:
+    """``J0(rho kappa)`` (nrho, nkappa), kept for reuse: a sweep over ground permittivities
+    meets the same radial grid and the same propagating nodes (``k sin(theta)``) again."""
+    key = hashlib.blake2b(rho.tobytes() + b"|" + kappa.tobytes(), digest_size=16).digest()
+    J = _J0_CACHE.get(key)
+    if J is None:
+        J = j0(np.outer(rho, kappa))
+        if J.nbytes <= _J0_CACHE_BYTES // 8:
+            while sum(v.nbytes for v in _J0_CACHE.values()) + J.nbytes > _J0_CACHE_BYTES:
+                _J0_CACHE.pop(next(iter(_J0_CACHE)))
+            J.setflags(write=False)
+            _J0_CACHE[key] = J
+    return J
+
+
 def transmitted_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarray,
                          rho: np.ndarray) -> np.ndarray:
     """Field of a unit point source in the air at range ``z_src`` at lateral distances
@@ -314,7 +334,7 @@ def transmitted_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarr
     acc = np.zeros((deep.size, rho.size), complex)
     for kap, w in pieces:
         k2 = kap**2
-        J = j0(np.outer(rho, kap))                                  # (nrho, nkappa)
+        J = _bessel_matrix(rho, kap)                                # (nrho, nkappa)
         f = 1j * medium.vertical_transfers(k, k2, z_src, z_obs[deep]) * (
             kap / medium.kz(k, k2, 0))                               # (nz, nkappa)
         acc += (f * w) @ J.T
