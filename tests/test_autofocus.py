@@ -70,7 +70,7 @@ def test_two_gigahertz_band_recovers_eps_within_5_percent(eps, source):
     (sigma 0.3%), so 5% is > 10 sigma."""
     depth = 5 * LAM0 / np.sqrt(eps)
     h = _scene_hologram(eps, depth, freq=BAND, snr_db=20.0, seed=1, source=source)
-    res = hr.autofocus(h, medium_model=_model(), depth_range=(0.02, 0.2))
+    res = hr.autofocus(h, medium_model=_model(), depth_range=(0.03, 0.15))
     assert res.determinable, res.reason
     assert abs(res.eps - eps) < 0.05 * eps
     assert res.eps_interval[0] < eps < res.eps_interval[1]
@@ -129,6 +129,7 @@ def test_combines_with_an_independent_glare_estimate():
     h = _scene_hologram(4.0, depth)
     alone = hr.autofocus(h, medium_model=_model())
     both = hr.autofocus(h, medium_model=_model(), glare=(4.1, 0.1))
+    assert alone.determinable and both.determinable, (alone.reason, both.reason)
     # Inverse-variance weighting: the combined sigma is below both.
     s_f = alone.std
     s = both.std
@@ -158,6 +159,29 @@ def test_glare_true_estimates_removes_and_combines():
     q = 1.959964
     s_focus = (res.eps_focus_interval[1] - res.eps_focus_interval[0]) / (2 * q)
     assert res.std < min(s_focus, res.eps_glare_std)
+
+
+def test_glare_alone_when_the_focus_gives_no_handle():
+    # Noise only: no object, so the glare's own estimate is the answer, said as such.
+    h = _scene_hologram(4.0, 0.08)
+    noise = np.random.default_rng(7).standard_normal((*h.shape, 2)) @ [1, 1j]
+    res = hr.autofocus(hr.Hologram(noise, h.x, h.y, F0), medium_model=_model(),
+                       glare=(3.8, 0.2))
+    assert res.determinable and res.eps == 3.8 and res.eps_focus is None
+    assert res.eps_interval == pytest.approx((3.8 - 1.96 * 0.2, 3.8 + 1.96 * 0.2), rel=1e-3)
+    assert "glare alone" in res.reason and "noise" in res.reason
+    assert "3.8" in str(res)
+
+
+def test_noise_alone_across_frequencies_without_the_source():
+    # One amplitude per frequency: noise alone sums nf exponential outputs (a Gamma
+    # variable); the detection threshold must follow, or 21 frequencies of noise would
+    # pass as an object.
+    h = _scene_hologram(4.0, 0.08, freq=np.linspace(9e9, 11e9, 21), snr_db=None)
+    noise = np.random.default_rng(8).standard_normal((*h.shape, 2)) @ [1, 1j]
+    res = hr.autofocus(hr.Hologram(noise, h.x, h.y, h.frequency), medium_model=_model())
+    assert res.eps is None and "noise" in res.reason
+    assert "without the illumination" in res.handle
 
 
 # ----------------------------------------------------------------- bad input

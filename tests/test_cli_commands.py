@@ -375,3 +375,10 @@ def test_autofocus_from_the_command_line_equals_the_library(tmp_path):
                        "3", ok=False), "--eps-range")
     one_line_error(run("autofocus", tmp_path / "h.nc", "--layers", "0.3:3,0.4:5", ok=False),
                    "half-space")
+    # Noise only: "not determinable" is an answer (exit 0), with the reason.
+    noise = np.random.default_rng(0).standard_normal((*h.shape, 2)) @ [1, 1j]
+    hr.save(hr.Hologram(noise, h.x, h.y, F), tmp_path / "n.nc")
+    res = run("autofocus", tmp_path / "n.nc", "--z-surface", "0.30", "--plot",
+              tmp_path / "n.png")
+    assert "not determinable" in res.stdout and "noise" in res.stdout
+    assert "no plot" in res.stdout and not (tmp_path / "n.png").exists()

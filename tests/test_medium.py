@@ -125,3 +125,16 @@ def test_permittivity_from_conductivity():
     # sigma = 0.0069 S/m at 9.9 GHz is the gprMax sand: Im(eps) = sigma/(omega eps0) = 0.0125.
     e = hr.permittivity(2.5, sigma=0.0069, frequency=9.9e9)
     assert e.imag == pytest.approx(0.01253, rel=1e-3)
+
+
+def test_vertical_transfers_equal_one_range_at_a_time_for_any_kappa_shape():
+    # Many ranges at once (the stack's coefficients computed once) against one at a time,
+    # through two layers and for 0-d, 1-d and 2-d spectra; exact to rounding.
+    m = hr.Medium.layered([0.3, 0.34], [3.0 + 0.03j, 6.0])
+    z = np.array([0.1, 0.2, 0.31, 0.33, 0.5, 0.6])  # two ranges in each region
+    for k2 in (np.array(900.0), np.linspace(0, 4e4, 7), np.linspace(0, 9e4, 12).reshape(3, 4)):
+        many = m.vertical_transfers(200.0, k2, 0.0, z)
+        assert many.shape == z.shape + k2.shape
+        for i, zi in enumerate(z):
+            np.testing.assert_allclose(many[i], m.vertical_transfer(200.0, k2, 0.0, zi),
+                                       rtol=1e-12, atol=1e-15)

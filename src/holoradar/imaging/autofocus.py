@@ -18,7 +18,7 @@ without that drift.
 
 Confidence interval: the profile likelihood. With ``R(eps') = ||h||^2 (1 -
 max_r F)`` the residual energy, the interval holds the eps' with
-``R - R_min <= z^2 * s^2 * phi``: ``z`` the normal quantile of the confidence,
+``R - R_min <= (z s sqrt(phi) + sqrt(E_err))^2``: ``z`` the normal quantile of the confidence,
 ``s^2 = R_min / (2N - 6)`` the residual's variance per real component (N complex
 samples, six real parameters), and ``phi >= 1`` a sandwich correction for a
 residual that is not white (model error: a sphere is not a point, a vector field
@@ -27,6 +27,8 @@ not a scalar one): ``phi = sum_k |D_k|^2 |R_k|^2 / (sigma^2 sum_k |D_k|^2)``, wi
 respect to eps' (made orthogonal to the derivatives in amplitude and position).
 It weighs the residual's power at the spatial frequencies (and delays) where
 eps' acts: 1 for white noise, more when the residual looks like a change of eps'.
+``E_err`` is the energy of the residual's smooth part (model error), which could
+shift the estimate by at most ``sqrt(E_err)/||D||``.
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ from typing import Any, Literal
 import numpy as np
 import scipy.fft as sfft
 from scipy.optimize import brentq, least_squares, minimize_scalar
-from scipy.stats import norm
+from scipy.stats import gamma, norm
 from tqdm.auto import tqdm
 
 from .._validate import AliasingWarning
@@ -122,8 +124,9 @@ class AutofocusResult:
     detection_threshold: float = 0.0
     noise_inflation: float = 1.0
     handle: str = ""
-    eps_grid: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    profile: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    eps_grid: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False,
+                                 compare=False)
+    profile: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False, compare=False)
     evaluations: int = 0
     integrals: int = 0
     seconds: float = 0.0
@@ -140,10 +143,12 @@ class AutofocusResult:
         if not self.determinable:
             return f"eps' not determinable: {self.reason}"
         lo, hi = self.eps_interval
-        z = self.position[2]
-        return (f"eps' = {self.eps:.3g} ({100 * self.confidence:.0f}% interval {lo:.3g} .. "
-                f"{hi:.3g}); object at range {z:.4g} m, {self.depth:.4g} m below the surface "
-                f"({self.handle})")
+        text = (f"eps' = {self.eps:.3g} ({100 * self.confidence:.0f}% interval {lo:.3g} .. "
+                f"{hi:.3g})")
+        if self.position is not None and self.depth is not None:
+            text += (f"; object at range {self.position[2]:.4g} m, {self.depth:.4g} m below the "
+                     "surface")
+        return f"{text} ({self.handle if self.eps_focus is not None else self.reason})"
 
 
 def _quantile(confidence: float) -> float:
@@ -205,7 +210,9 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         ``range_interval``; or ``determinable=False`` and ``eps=None`` with the
         ``reason`` when the scene gives no handle: no object above the noise, an
         object at the surface or too shallow for the aperture, a best focus at the
-        edge of ``eps_range``, or an interval that reaches it.
+        edge of ``eps_range``, an interval that reaches it, or two permittivities that
+        focus equally well ("ambiguous": aliases of the delay left by the frequency
+        step).
 
     Examples
     --------
@@ -269,7 +276,8 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
                                integrals=pr.integrals,
                                seconds=time.perf_counter() - t_start, **kw)
 
-    # 1. Where is the object? The brightest voxel of a migrated image.
+    # 1. Where is the object? Laterally the brightest column of a migrated image; its
+    #    range, curvature and delay from the point fit along that column.
     located = search.locate(depth_range, position, z0)
     if located is None:
         return finish(eps=None, eps_interval=None, determinable=False,
@@ -299,16 +307,17 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     seeds += [(max(lo, c / 1.03), c, min(hi, c * 1.03)) for c in search.candidates()]
     modes = []
     for a, c, b in seeds:
-        if c in (lo, hi) or not a < c < b:
+        F_c = search.evaluate(c)[0]
+        best_so_far = max(f for f, _, _ in search.best.values())
+        # Refine only what could rival the best: a residual within twice the best's.
+        if c in (lo, hi) or not a < c < b or 1 - F_c > 2 * (1 - best_so_far):
             modes.append(c)
-            search.evaluate(c)
             continue
-        opt = minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
-                              bounds=(np.log(a), np.log(b)), method="bounded",
-                              options={"xatol": 1e-3})
+        minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
+                        bounds=(np.log(a), np.log(b)), method="bounded",
+                        options={"xatol": 1e-3})
         modes.append(max((e for e in search.best if a <= e <= b),
                          key=lambda e: search.best[e][0]))
-        del opt
     e_hat = max(search.best, key=lambda e: search.best[e][0])
     F_max, z_hat, xy_hat = search.best[e_hat]
     # 4. Noise level, detection and the sandwich factor at the optimum.
@@ -324,7 +333,8 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         return finish(eps=None, eps_interval=None, determinable=False,
                       reason=f"the sharpest focus lies at the edge of eps_range ({lo:g} .. "
                              f"{hi:g}): widen it, or the scene gives no handle", **common)
-    # 5. Profile-likelihood interval: R(eps) - R_min <= q^2 s^2 phi, in focus-fraction units.
+    # 5. Profile-likelihood interval, R(eps) - R_min <= (q s sqrt(phi) + sqrt(E_err))^2, in
+    #    focus-fraction units.
     # The statistical part (noise, q s sqrt(phi)) and a bound on the bias a smooth model
     # error of energy E_err can cause, were it aligned with the change of eps' (profile
     # residual rises as ||d||^2 delta^2, the bias is at most sqrt(E_err)/||d||): the
@@ -366,7 +376,9 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
 
 
 class _Search:
-    """The best focus for each trial eps': range by a polynomial fit, lateral by simplex."""
+    """The best focus for each trial eps': the range from a scan (around the paraxially
+    equivalent range and every alias of the delay), then range and lateral position by
+    bounded Gauss-Newton."""
 
     def __init__(self, pr: PointResponse, make: Callable[[float], Medium], lo: float, hi: float,
                  hologram: Hologram) -> None:
@@ -478,8 +490,8 @@ class _Search:
     def evaluate(self, eps: float) -> tuple[float, float, np.ndarray]:
         """Best focus fraction at ``eps`` with its range and lateral position.
 
-        Gauss-Newton (Levenberg-Marquardt) on the residual ``h - a g`` with the
-        amplitude ``a`` projected out, from the paraxially equivalent range.
+        Bounded Gauss-Newton (trust region) on the residual ``h - a g`` with the
+        amplitude ``a`` projected out, from the best range of a scan.
         """
         if eps in self.best:
             return self.best[eps]
@@ -516,8 +528,12 @@ class _Search:
         # Bounded to the scanned peak's basin: an unbounded first step may jump to another
         # alias of the delay.
         reach = C0 / (4 * self.band * np.sqrt(eps)) if self.wideband else 2 * lam_m
-        lo_b = np.array([*(p0[:2] - 2 * lam_m), max(p0[2] - reach, floor)])
-        hi_b = np.array([*(p0[:2] + 2 * lam_m), p0[2] + reach])
+        p0[:2] = np.clip(p0[:2], *pr.bounds)
+        lo_b = np.array([*np.maximum(p0[:2] - 2 * lam_m, pr.bounds[0]), max(p0[2] - reach,
+                                                                            floor)])
+        hi_b = np.array([*np.minimum(p0[:2] + 2 * lam_m, pr.bounds[1]), p0[2] + reach])
+        lo_b[:2] = np.minimum(lo_b[:2], p0[:2] - 1e-9)  # a non-empty box at the edge
+        hi_b[:2] = np.maximum(hi_b[:2], p0[:2] + 1e-9)
         sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-12,
                             ftol=1e-15, gtol=1e-15, x_scale=np.full(3, self.lam / 10))
         p = sol.x
@@ -559,7 +575,8 @@ class _Search:
         rf, gf, _ = pr.residual(eps, z, xy, phase=False)
         s2f = max(float(np.vdot(rf, rf).real) / max(2 * n_complex - 4 - 2 * n_amp, 1), floor)
         detection = pr.energy * pr.match(gf, phase=False)[0] / (2 * s2f)
-        threshold = float(np.log(self.trials / _FALSE_ALARM))
+        # With one amplitude per frequency the output sums n_amp such variables (Gamma).
+        threshold = float(gamma.isf(_FALSE_ALARM / self.trials, n_amp))
         # Residual variance per real component: a phase-only residual has one real
         # component per sample (along the phase), a field residual two.
         r, g, a = pr.residual(eps, z, xy)

@@ -44,7 +44,7 @@ from ..physics.sources import PlaneWave, PointSource, ray_direction
 
 __all__ = ["PointResponse"]
 
-_RHO_STEPS = 16   # radial samples per wavelength in the ground
+_RHO_STEPS = 16   # radial samples per wavelength (in air; in the ground for a thin gap)
 _Z_STEPS = 8      # range samples per wavelength in the ground
 _Z_HALF = 6       # a window holds 2*_Z_HALF + 1 ranges (+- 0.75 wavelength)
 
@@ -120,7 +120,7 @@ class PointResponse:
              coherent: bool | None = None) -> tuple[float, float]:
         """Range in [z_lo, z_hi] with the best focus at ``xy``, and that focus fraction.
 
-        Sampled at :meth:`spacing`, or in ``samples`` steps when that is finer (a wide
+        Sampled at :meth:`spacing`, or in ``samples`` steps when that is coarser (a wide
         search only needs a start: the fit then refines the range on a fine window).
         """
         n = int(np.ceil((z_hi - z_lo) / self.spacing(eps)))
@@ -128,11 +128,12 @@ class PointResponse:
             return self.match(self.response(eps, z, xy, window=w), coherent=coherent)[0]
 
         if not self.flat:
-            zs = np.linspace(z_lo, z_hi, max(min(n, samples), 2))
+            zs = np.linspace(z_lo, z_hi, max(min(n, samples), 2))  # exact, slow: few
             F = [f(z) for z in zs]
         elif n <= 2 * _Z_HALF:
             w = self._window(float(eps), 0.5 * (z_lo + z_hi), z_hi - z_lo)
-            zs = w.zs[1:-2]
+            zs = w.zs[(w.zs >= z_lo) & (w.zs <= z_hi)]
+            zs = zs if zs.size else np.array([0.5 * (z_lo + z_hi)])
             F = [f(z) for z in zs]
         else:
             zs = np.linspace(z_lo, z_hi, samples)
@@ -143,7 +144,7 @@ class PointResponse:
 
     def _window(self, eps: float, z: float, span: float = 0.0) -> _Window:
         for w in self._windows.get(eps, []):
-            if w.holds(z) and w.zs[-3] - w.zs[1] >= span:
+            if w.holds(z) and w.zs[-1] - w.zs[0] >= span:
                 return w
         dz = self.spacing(eps)
         z0 = self.make_medium(float(eps)).z_interfaces[0]
@@ -263,7 +264,7 @@ class PointResponse:
     def window_range(self, eps: float, z: float) -> tuple[float, float]:
         """Ranges covered by the window that holds ``z`` at ``eps`` (computing it if new)."""
         w = self._window(float(eps), float(z))
-        return float(w.zs[1]), float(w.zs[-3])
+        return float(w.zs[0]), float(w.zs[-1])
 
 
 class _Window:
@@ -271,8 +272,8 @@ class _Window:
         self.zs, self.G, self.E, self.medium = zs, G, E, medium
 
     def holds(self, z: float) -> bool:
-        # The 4-point interpolation needs a sample on either side.
-        return bool(self.zs[1] <= z <= self.zs[-3])
+        # The 4-point stencil is clamped inside the grid: valid over its whole span.
+        return bool(self.zs[0] <= z <= self.zs[-1])
 
 
 class _Grid:

@@ -37,6 +37,7 @@ from scipy.interpolate import CubicSpline
 from scipy.special import j0, roots_legendre
 
 from .medium import Medium
+from .propagation import _TransferCache
 
 __all__ = ["free_space_green", "green_at_distances", "layered_green", "transmitted_profiles"]
 
@@ -279,23 +280,20 @@ def _reflected(k: float, medium: Medium, rho: np.ndarray, air_path: np.ndarray) 
     return out
 
 
-_J0_CACHE: dict[bytes, np.ndarray] = {}
-_J0_CACHE_BYTES = 256 * 2**20
+_J0_CACHE = _TransferCache(128 * 2**20)
 
 
 def _bessel_matrix(rho: np.ndarray, kappa: np.ndarray) -> np.ndarray:
-    """``J0(rho kappa)`` (nrho, nkappa), kept for reuse: a sweep over ground permittivities
-    meets the same radial grid and the same propagating nodes (``k sin(theta)``) again."""
-    key = hashlib.blake2b(rho.tobytes() + b"|" + kappa.tobytes(), digest_size=16).digest()
-    J = _J0_CACHE.get(key)
-    if J is None:
-        J = j0(np.outer(rho, kappa))
-        if J.nbytes <= _J0_CACHE_BYTES // 8:
-            while sum(v.nbytes for v in _J0_CACHE.values()) + J.nbytes > _J0_CACHE_BYTES:
-                _J0_CACHE.pop(next(iter(_J0_CACHE)))
-            J.setflags(write=False)
-            _J0_CACHE[key] = J
-    return J
+    """``J0(rho kappa)`` (nrho, nkappa), kept for reuse (least recently used, 128 MiB at
+    most, thread-safe): a sweep over ground permittivities meets the same radial grid and
+    the same propagating nodes (``k sin(theta)``) again."""
+    digest = hashlib.blake2b(rho.tobytes() + b"|" + kappa.tobytes(), digest_size=16).digest()
+    return _J0_CACHE.get((rho.shape, kappa.shape, digest), lambda: j0(np.outer(rho, kappa)))
+
+
+def clear_bessel_cache() -> None:
+    """Free the kept Bessel matrices of :func:`transmitted_profiles`."""
+    _J0_CACHE.clear()
 
 
 def transmitted_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarray,

@@ -589,7 +589,7 @@ class Medium:
         st = self._interfaces(k, kappa2) if np.any(regions > 0) else None
         for region in np.unique(regions):
             sel = np.nonzero(regions == region)[0]
-            dz = z_to[sel][:, None]
+            dz = z_to[sel].reshape((-1,) + (1,) * kappa2.ndim)
             if region == 0:
                 out[sel] = np.exp(1j * kz0 * (dz - z_from))
                 continue

@@ -21,11 +21,11 @@ from .common import (
 __all__ = ["COMMANDS"]
 
 
-def _pair(text: str, name: str) -> tuple[float, float]:
+def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
     try:
         a, b = (float(v) for v in text.split(","))
     except ValueError:
-        raise click.BadParameter(f"expected two numbers MIN,MAX, got {text!r}",
+        raise click.BadParameter(f"expected two numbers {form}, got {text!r}",
                                  param_hint=name) from None
     return a, b
 
@@ -72,12 +72,15 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
 
     eps_pair = _pair(eps_range, "--eps-range")
     depth_pair = None if depth_range is None else _pair(depth_range, "--depth-range")
-    at = None if position is None else _pair(position, "--at")
+    at = None if position is None else _pair(position, "--at", "X,Y")
     if glare and glare_estimate:
         raise click.BadParameter("give --glare or --glare-estimate, not both",
                                  param_hint="--glare")
-    glare_arg: Any = True if glare else (_pair(glare_estimate, "--glare-estimate")
-                                         if glare_estimate else None)
+    glare_arg: Any = None
+    if glare:
+        glare_arg = True
+    elif glare_estimate:
+        glare_arg = _pair(glare_estimate, "--glare-estimate", "EPS,SIGMA")
     if plot_file is not None:
         check_output(plot_file, suffixes=[".png"], inputs=[hologram_file], overwrite=force,
                      name="--plot")
@@ -93,9 +96,14 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
               position=at, glare=glare_arg, fit=fit, confidence=confidence,
               progress=report.progress)
     files = []
-    if plot_file is not None and res.eps_grid.size:
-        _plot(res, plot_file, hologram_file.name)
-        files.append(str(plot_file))
+    lines = [str(res)]
+    if plot_file is not None:
+        if res.eps_grid.size > 1:
+            _plot(res, plot_file, hologram_file.name)
+            files.append(str(plot_file))
+        else:
+            lines.append(f"no plot: the search stopped before a sweep of eps' "
+                         f"({plot_file} not written)")
     summary = {
         "determinable": res.determinable, "eps": res.eps,
         "eps_interval": res.eps_interval, "confidence": res.confidence,
@@ -105,7 +113,6 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
         "handle": res.handle, "focus_fraction": res.focus_fraction,
         "evaluations": res.evaluations, "seconds": res.seconds, "files": files,
     }
-    lines = [str(res)]
     if res.position is not None:
         x, y, z = res.position
         lines.append(f"object at x={100 * x:.1f} y={100 * y:.1f} cm, range {100 * z:.1f} cm")
