@@ -33,8 +33,9 @@ def _kept(clean: hr.Hologram, objects: hr.Hologram) -> float:
     return float(abs(np.vdot(t, clean.data.ravel())) / np.vdot(t, t).real)
 
 
-@pytest.mark.parametrize("method, alpha", [("gaussian", 0.0), ("gaussian", 30.0),
-                                           ("image_source", 0.0), ("image_source", 20.0)])
+@pytest.mark.parametrize("method, alpha", [
+    ("gaussian", 0.0), ("gaussian", 30.0), ("image_source", 0.0),
+    pytest.param("image_source", 20.0, marks=pytest.mark.slow)])  # 11 s: make test-slow
 def test_beam_glare_and_direct_wave_removed_object_kept(method, alpha):
     """Glare and direct beam 20-23 dB above the object. Required: the glare's spot down
     by >= 20 dB, >= 80% of the object kept, and the object the brightest thing of the
