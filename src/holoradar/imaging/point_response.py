@@ -25,9 +25,9 @@ lateral distance and the object's range only. For each trial permittivity it is
 computed once on a window of ranges (spacing lambda/8 in the ground) and a
 radial grid (lambda/16 in the air), with one quadrature shared by all ranges
 (:func:`~holoradar.physics.green.transmitted_profiles`), and interpolated by
-bicubic splines of its amplitude and unwrapped phase (both smooth on the scale
-of the wavelength): moving the object costs no new integral. A point source's
-incident field is interpolated the same way.
+4 x 4-point (bicubic Lagrange) interpolation of its amplitude and unwrapped
+phase (both smooth on the scale of the wavelength): moving the object costs no
+new integral. A point source's incident field is interpolated the same way.
 """
 
 from __future__ import annotations
