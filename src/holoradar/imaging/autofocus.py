@@ -143,8 +143,10 @@ class AutofocusResult:
         if not self.determinable:
             return f"eps' not determinable: {self.reason}"
         lo, hi = self.eps_interval
-        text = (f"eps' = {self.eps:.3g} ({100 * self.confidence:.0f}% interval {lo:.3g} .. "
-                f"{hi:.3g})")
+        # Enough decimals that the interval's width shows (2 at least).
+        d = max(2, 1 - int(np.floor(np.log10(max(hi - lo, 1e-12)))))
+        text = (f"eps' = {self.eps:.{d}f} ({100 * self.confidence:.0f}% interval {lo:.{d}f} .. "
+                f"{hi:.{d}f})")
         if self.position is not None and self.depth is not None:
             text += (f"; object at range {self.position[2]:.4g} m, {self.depth:.4g} m below the "
                      "surface")
