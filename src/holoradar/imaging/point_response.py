@@ -85,7 +85,6 @@ class PointResponse:
     def __init__(self, hologram: Hologram, make_medium: Callable[[float], Medium], *,
                  coherent: bool, phase_only: bool = False) -> None:
         self.phase_only = bool(phase_only)
-        self.shape = hologram.data.shape
         self.h = hologram.data.reshape(hologram.nf, -1)
         self.energy = float(np.vdot(self.h, self.h).real)
         self.points = hologram.points
@@ -260,11 +259,6 @@ class PointResponse:
         g = self.response(eps, z, xy)
         _, a = self.match(g, phase=phase)
         return self.h - self.model(g, a, phase=phase), g, a
-
-    def window_range(self, eps: float, z: float) -> tuple[float, float]:
-        """Ranges covered by the window that holds ``z`` at ``eps`` (computing it if new)."""
-        w = self._window(float(eps), float(z))
-        return float(w.zs[0]), float(w.zs[-1])
 
 
 class _Window:
