@@ -394,6 +394,8 @@ class _Search:
         f = hologram.frequencies
         self.wideband = f.size > 1 and pr.coherent
         self.band = float(f.max() - f.min()) if f.size > 1 else 0.0
+        # Uniformly stepped frequencies fix the optical path only modulo c/(2 df).
+        self.alias = C0 / (2 * float(np.min(np.diff(f)))) if self.wideband else np.inf
         self.z0 = 0.0
         self.trials = 1
 
@@ -454,11 +456,9 @@ class _Search:
         ``c/(2 df)``, so ``n^2 = (P + m c/(2 df) - z0)/(A - z0)`` for each integer m."""
         if not self.wideband or self.A <= self.z0:
             return []
-        step = float(np.min(np.diff(self.hologram.frequencies)))
-        alias = C0 / (2 * step)
         out = []
         for m in range(-50, 51):
-            e = (self.P + m * alias - self.z0) / (self.A - self.z0)
+            e = (self.P + m * self.alias - self.z0) / (self.A - self.z0)
             if self.lo < e < self.hi:
                 out.append(float(e))
         return out
@@ -467,18 +467,16 @@ class _Search:
         """Ranges whose normal-incidence optical path is the located one, or one of its
         aliases ``P + m c/(2 df)`` (uniformly stepped frequencies)."""
         m = self.make(eps)
-        step = float(np.min(np.diff(self.hologram.frequencies)))
-        alias = C0 / (2 * step)
         out = []
         for k in range(-50, 51):
-            P = self.P + k * alias
+            P = self.P + k * self.alias
             if P <= self.z0:
                 continue
             top = self.z0 + (P - self.z0) * 2 + 1e-3
             if m.optical_path(top).real < P or m.optical_path(self.z0).real > P:
                 continue
             z = float(brentq(lambda z, P=P: m.optical_path(z).real - P, self.z0, top))
-            if z > self.depths[1] + alias:
+            if z > self.depths[1] + self.alias:
                 break
             out.append(z)
         return out
@@ -508,7 +506,6 @@ class _Search:
         # (one frequency) or between it and the range of the same delay (several).
         z_c = self.paraxial_range(eps) + offset
         lam_m = self.lam / np.sqrt(eps)
-        ends = [z_c - lam_m / 2, z_c + lam_m / 2]
         if self.wideband:
             # Around the paraxial range and every alias of the delay within the depths
             # searched (the best may be any), finely: the focus peaks over about half the
@@ -520,7 +517,8 @@ class _Search:
                                       xy0, samples=17) for c in centres),
                              key=lambda t: t[1])
         else:
-            z_start, _ = pr.scan(eps, max(ends[0], floor), max(ends[1], floor + lam_m), xy0)
+            z_start, _ = pr.scan(eps, max(z_c - lam_m / 2, floor),
+                                 max(z_c + lam_m / 2, floor + lam_m), xy0)
         p0 = np.array([xy0[0], xy0[1], z_start])
 
         def resid(p: np.ndarray) -> np.ndarray:
@@ -572,8 +570,8 @@ class _Search:
         n_complex = pr.h.size
         floor = (_MODEL_PRECISION ** 2) * pr.energy / (2 * n_complex)
         # Detection, from the complex-field fit: the matched filter's output over the
-        # complex noise variance 2 s^2 is exponential for noise alone; its largest value
-        # over the trials is ~ log(trials).
+        # complex noise variance 2 s^2 is exponential for noise alone (per amplitude); the
+        # threshold is its level exceeded with chance _FALSE_ALARM over all the trials.
         rf, gf, _ = pr.residual(eps, z, xy, phase=False)
         s2f = max(float(np.vdot(rf, rf).real) / max(2 * n_complex - 4 - 2 * n_amp, 1), floor)
         detection = pr.energy * pr.match(gf, phase=False)[0] / (2 * s2f)

@@ -123,6 +123,7 @@ class PointResponse:
         search only needs a start: the fit then refines the range on a fine window).
         """
         n = int(np.ceil((z_hi - z_lo) / self.spacing(eps)))
+
         def f(z: float, w: _Window | None = None) -> float:
             return self.match(self.response(eps, z, xy, window=w), coherent=coherent)[0]
 
