@@ -89,9 +89,9 @@ def main() -> None:
 
 
 def _register() -> None:
-    from . import batch, calibrate, focus, image, info, misc, plot, process, simulate
+    from . import batch, calibrate, focus, image, info, misc, plot, process, simulate, view
 
-    for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch):
+    for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch, view):
         for cmd in module.COMMANDS:
             main.add_command(cmd)
 

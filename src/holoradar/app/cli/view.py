@@ -1,0 +1,187 @@
+"""``holoradar view`` (the browser viewer) and ``holoradar render`` (a saved look in batch)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .common import Reporter, layout_option, medium_options, output_options
+
+__all__ = ["COMMANDS", "ground_from_options"]
+
+
+def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[str, Any] | None:
+    """The ground flags as a table of a scene file (``surface``/``eps`` or ``layer``), checked
+    by building the medium; None without a ground."""
+    from ...model.scene_file import medium_from_mapping
+    from .common import medium_from_options
+
+    if spec["medium_file"] is not None:
+        medium_from_options(spec, frequency or 1e10)  # the same checks and messages
+        doc = tomllib.loads(Path(spec["medium_file"]).read_text(encoding="utf-8"))
+        return dict(doc.get("ground", doc))
+    medium = medium_from_options(spec, frequency or 1e10)
+    if medium is None:
+        return None
+    if spec["layers"] is not None:
+        layers = []
+        for part in spec["layers"].split(","):
+            top, _, value = part.partition(":")
+            layers.append({"top": float(top), "eps": value.strip(),
+                           **{k: spec[k] for k in ("tan_delta", "sigma") if spec[k] is not None}})
+        table: dict[str, Any] = {"layer": layers}
+    else:
+        table = {"surface": float(spec["z_surface"]), "eps": str(spec["eps"]).strip(),
+                 **{k: spec[k] for k in ("tan_delta", "sigma") if spec[k] is not None}}
+    medium_from_mapping(table, frequency or 1e10, where="ground")
+    return table
+
+
+@click.command()
+@click.argument("files", nargs=-1, type=click.Path(exists=True, path_type=Path))
+@medium_options
+@click.option("--settings", "settings_file", default=None,
+              type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="Start from a look saved by the page's 'export settings' (its files are "
+                   "opened when no FILES are given).")
+@click.option("--depth", type=float, default=None,
+              help="First depth below the surface (range without a ground), m; default the "
+                   "brightest plane of the sweep.")
+@click.option("--glare", type=click.Choice(["off", "gaussian", "image_source", "cut"]),
+              default=None, help="Glare suppression to start with (default off).")
+@click.option("--host", default="127.0.0.1", show_default=True,
+              help="Address to serve on. Anything but the loopback shows the data to the "
+                   "network (a warning says so).")
+@click.option("--port", default=0, type=click.IntRange(0, 65535),
+              help="Port to serve on; default a free one.")
+@click.option("--export-dir", default=None,
+              type=click.Path(exists=True, file_okay=False, path_type=Path),
+              help="Folder for the page's exports (default: the current folder).")
+@click.option("--browser/--no-browser", default=True, show_default=True,
+              help="Open the page in the default browser.")
+@layout_option
+@output_options
+def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Path | None,
+         depth: float | None, glare: str | None, host: str, port: int,
+         export_dir: Path | None, browser: bool, layout: str | None, check: bool,
+         report: Reporter) -> None:
+    """Look at holograms, images or a survey in the browser, turning the knobs live.
+
+    FILES: holograms (one per view of the scene: they are summed), or one
+    image/volume file, or one survey store (.zarr). The page sweeps depth,
+    removes the surface glare, sums views, shows sections, the spectral window,
+    a cursor readout and distances, and exports a PNG, the image (NetCDF) and
+    the settings (TOML; `holoradar render` reproduces the image from it).
+    Serves until Ctrl+C.
+    """
+    from ..view.server import make_server, open_in_browser, url_of
+    from ..view.session import ViewSession
+    from ..view.settings import read_settings
+
+    base = read_settings(settings_file) if settings_file is not None else None
+    paths = list(files) or ([Path(f) for f in base.files] if base is not None else [])
+    if not paths:
+        raise click.BadParameter("give the files to view (or --settings with files)",
+                                 param_hint="FILES")
+    for p in paths:
+        if not p.exists():
+            raise click.BadParameter(f"{p} does not exist", param_hint="FILES")
+    session = ViewSession(paths, layout=layout, check=check)
+    freq = float(np.mean(session.frequencies)) if session.frequencies.size else None
+    ground = ground_from_options(medium_spec, freq)
+    ground_file = ground if ground is not None and "layer" in ground else None
+    if base is not None:
+        s = base.replace(files=tuple(str(p) for p in paths))
+        if ground is not None:
+            s = s.replace(ground=ground)
+    else:
+        s = session.default_settings(ground=ground)
+    if glare is not None:
+        s = s.replace(glare=glare)
+    if depth is not None:
+        s = s.replace(depth=depth)
+    elif base is None and session.kind == "holograms":
+        from ...analysis.metrics import peak_position
+
+        s = s.replace(depth=float(peak_position(session.sweep(s))[2] - session.surface(s)))
+    session.medium(s)  # a bad ground fails here, before the server starts
+    server = make_server(session, s, host=host, port=port, export_dir=export_dir,
+                         ground_file=ground_file)
+    url = url_of(server, host)
+    report.done({"url": url, "files": [str(p) for p in paths]},
+                [f"holoradar view: serving {url} (Ctrl+C to stop)"])
+    import sys
+
+    sys.stdout.flush()
+    if browser:
+        open_in_browser(url)
+    try:
+        server.io_loop.start()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+
+
+@click.command()
+@click.argument("settings_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="The image shown by the look, .nc.")
+@click.option("--png/--no-png", default=True, show_default=True,
+              help="Also write the look's figure (plane and sections) beside --out.")
+@click.option("--force", is_flag=True, help="Replace existing output files.")
+@layout_option
+@output_options
+def render(settings_file: Path, out: Path, png: bool, force: bool, layout: str | None,
+           check: bool, report: Reporter) -> None:
+    """Reproduce a look saved by `holoradar view` ('export settings') in batch.
+
+    SETTINGS_FILE: the TOML the page wrote (files, ground, depth, glare, views,
+    frequencies, display). Writes the image the page showed and its figure.
+    """
+    from ...io import save
+    from ...io.output import check_output
+    from ..atomic import write_atomic
+    from ..plotting import to_png
+    from ..view.display import peak_of
+    from ..view.export import look_figure, look_history
+    from ..view.session import ViewSession
+    from ..view.settings import read_settings
+
+    s = read_settings(settings_file)
+    if not s.files:
+        raise click.BadParameter(f"{settings_file.name} names no files", param_hint="SETTINGS")
+    inputs = [settings_file, *(Path(f) for f in s.files)]
+    check_output(out, suffixes=[".nc", ".nc4"], inputs=inputs, overwrite=force, name="--out")
+    if png:
+        check_output(out.with_suffix(".png"), suffixes=[".png"], inputs=inputs,
+                     overwrite=force, name="--out's PNG")
+    for f in s.files:
+        if not Path(f).exists():
+            raise click.BadParameter(f"{f} (named in {settings_file.name}) does not exist",
+                                     param_hint="SETTINGS")
+    session = ViewSession([Path(f) for f in s.files], layout=layout, check=check)
+    img = session.image(s)
+    ref = float(np.abs(img.data).max()) or 1.0
+    pk = peak_of(img, ref)
+    fig_bytes = to_png(look_figure(session, s)) if png else None
+    save(img, out, overwrite=force, history=look_history(s))
+    files = [str(out)]
+    if fig_bytes is not None:
+        write_atomic(out.with_suffix(".png"), fig_bytes)
+        files.append(str(out.with_suffix(".png")))
+    surf = session.surface(s) if s.plane == "image" else 0.0
+    report.done({"peak_m": [pk.x, pk.y, pk.z], "depth_m": pk.z - surf, "out": str(out),
+                 "files": files}, [
+        f"rendered {settings_file.name}: plane at range {float(img.z[0]) * 100:.1f} cm",
+        f"brightest point x={pk.x * 100:.2f} y={pk.y * 100:.2f} cm, "
+        f"{'depth' if s.ground is not None and s.plane == 'image' else 'range'} "
+        f"{(pk.z - surf) * 100:.2f} cm",
+        *[f"wrote {f}" for f in files]])
+
+
+COMMANDS = [view, render]

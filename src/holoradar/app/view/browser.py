@@ -1,0 +1,164 @@
+"""Drive the viewer in headless Chromium: for the end-to-end tests, the latency benchmark
+and the documentation's screenshots.
+
+Uses Selenium with the system's Chromium and its chromedriver (Debian's
+``chromium`` and ``chromium-driver`` packages; ``make test`` installs them
+where it can). :func:`find_chromium` says what is missing.
+
+The page's state is read from the Bokeh models the page names (``peak``,
+``glare_report``, ``depth``...): their text is what the page shows.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = ["ViewerProcess", "find_chromium", "headless_chromium", "measure_slider",
+           "model_value", "set_model", "wait_idle"]
+
+
+def find_chromium() -> tuple[str | None, str | None, str]:
+    """``(chromium, chromedriver, why)``: the executables found, and what is missing."""
+    chrome = next((p for p in (os.environ.get("HOLORADAR_CHROMIUM"), shutil.which("chromium"),
+                               shutil.which("chromium-browser"), shutil.which("google-chrome"))
+                   if p), None)
+    driver = os.environ.get("HOLORADAR_CHROMEDRIVER") or shutil.which("chromedriver")
+    missing = [n for n, p in (("chromium", chrome), ("chromedriver", driver)) if not p]
+    why = "" if not missing else (
+        f"no {' and no '.join(missing)} on PATH (install Debian's chromium and "
+        "chromium-driver, or set HOLORADAR_CHROMIUM and HOLORADAR_CHROMEDRIVER)")
+    try:
+        import selenium  # noqa: F401
+    except ImportError:
+        why = (why + "; " if why else "") + "selenium is not installed (pip install selenium)"
+    return chrome, driver, why
+
+
+def headless_chromium(width: int = 1600, height: int = 1000) -> Any:
+    """A Selenium driver of headless Chromium with the browser console logged."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+
+    chrome, driver, why = find_chromium()
+    if why:
+        raise RuntimeError(why)
+    opts = Options()
+    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+              f"--window-size={width},{height}", "--hide-scrollbars"):
+        opts.add_argument(a)
+    opts.binary_location = chrome
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(driver), options=opts)
+
+
+class ViewerProcess:
+    """``holoradar view ARGS --no-browser --json`` in a child process; ``url`` once ready.
+
+    A context manager: the server is stopped on exit.
+    """
+
+    def __init__(self, args: Sequence[str], *, cwd: str | Path | None = None,
+                 timeout: float = 60.0) -> None:
+        cmd = [sys.executable, "-m", "holoradar", "view", *map(str, args),
+               "--no-browser", "--json"]
+        env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"}
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     cwd=cwd, env=env, text=True)
+        lines = []
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < timeout:
+            line = self.proc.stdout.readline()  # type: ignore[union-attr]
+            if not line:
+                break
+            lines.append(line)
+            if line.startswith("}"):
+                break
+        try:
+            self.url = json.loads("".join(lines))["url"]
+        except (json.JSONDecodeError, KeyError):
+            self.stop()
+            err = self.proc.stderr.read() if self.proc.stderr else ""  # type: ignore[union-attr]
+            raise RuntimeError(f"holoradar view did not start: {''.join(lines)} {err}") from None
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+
+    def __enter__(self) -> ViewerProcess:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.stop()
+
+
+_MODEL = "Bokeh.documents[0].get_model_by_name(arguments[0])"
+
+
+def wait_idle(driver: Any, timeout: float = 60.0) -> None:
+    """Wait until the page has drawn its first picture and no imaging is pending."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        ready = driver.execute_script(
+            "const d = window.Bokeh && Bokeh.documents[0];"
+            "if (!d) return false; const p = d.get_model_by_name('peak');"
+            "const s = d.get_model_by_name('status');"
+            "return p !== null && p.text.length > 0 && !s.text.includes('...');")
+        if ready:
+            return
+        time.sleep(0.05)
+    raise TimeoutError("the viewer page did not become ready")
+
+
+def model_value(driver: Any, name: str, attr: str = "text") -> Any:
+    """A property of the page's model called ``name`` (e.g. a Div's ``text``)."""
+    return driver.execute_script(f"return {_MODEL}[arguments[1]];", name, attr)
+
+
+def set_model(driver: Any, name: str, attr: str, value: Any, *, settle: float = 0.0) -> None:
+    """Set a widget's property as a user's action would (it reaches the server), then wait
+    for the page to settle."""
+    driver.execute_script(f"{_MODEL}[arguments[1]] = arguments[2];", name, attr, value)
+    time.sleep(settle)
+    wait_idle(driver)
+
+
+_LATENCY_JS = """
+const done = arguments[arguments.length - 1];
+const doc = Bokeh.documents[0];
+const src = doc.get_model_by_name('image_source');
+const slider = doc.get_model_by_name('depth');
+const t0 = performance.now();
+const on = () => {
+  src.change.disconnect(on);
+  requestAnimationFrame(() => requestAnimationFrame(() => done(performance.now() - t0)));
+};
+src.change.connect(on);
+slider.value = arguments[0];
+setTimeout(() => { src.change.disconnect(on); done(-1); }, 20000);
+"""
+
+
+def measure_slider(driver: Any, depths_cm: Sequence[float]) -> list[float]:
+    """Milliseconds from each depth-slider move to the new picture painted in the browser
+    (the image's data arrived and two animation frames passed)."""
+    driver.set_script_timeout(30)
+    out = []
+    for d in depths_cm:
+        ms = driver.execute_async_script(_LATENCY_JS, float(d))
+        if ms < 0:
+            raise TimeoutError(f"no new picture after moving the slider to {d} cm")
+        out.append(float(ms))
+    return out

@@ -1,0 +1,129 @@
+"""What the viewer exports: a PNG of the look, the image as NetCDF, the settings TOML.
+
+The same functions serve ``holoradar render`` (a look reproduced in batch).
+Files are written atomically; an existing file is never replaced: the page
+picks the next free name (``..._2.png``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...data.hologram import Image
+from .display import CM, peak_of, scaled, sections
+from .session import ViewSession
+from .settings import ViewSettings, settings_toml
+
+__all__ = ["export_netcdf", "export_png", "export_settings", "look_figure", "look_history"]
+
+
+def _free_name(folder: Path, stem: str, suffix: str) -> Path:
+    p = folder / f"{stem}{suffix}"
+    i = 2
+    while p.exists():
+        p = folder / f"{stem}_{i}{suffix}"
+        i += 1
+    return p
+
+
+def _stem(session: ViewSession, s: ViewSettings) -> str:
+    base = session.paths[0].stem if session.paths else "view"
+    what = "mirror" if s.plane == "mirror" else f"{s.depth * CM:.1f}cm".replace("-", "m")
+    return f"{base}_{what}"
+
+
+def _reference(session: ViewSession, s: ViewSettings, volume: Image) -> float:
+    """The colour scale's 0 dB: the sweep's brightest voxel (the unsuppressed glare in the
+    mirror-source plane), as on the page."""
+    if s.plane == "mirror":
+        return float(np.abs(session.mirror_plane(s.replace(glare="off")).data).max()) or 1.0
+    return float(np.abs(volume.data).max()) or 1.0
+
+
+def look_figure(session: ViewSession, s: ViewSettings) -> Any:
+    """A matplotlib figure of the look: the plane and the two vertical sections, on the
+    page's colour scale, labelled in cm."""
+    from matplotlib.figure import Figure
+
+    from ...analysis.metrics import peak_position
+    from ..plotting import _edges
+
+    img = session.image(s)
+    vol = session.sweep(s)
+    ref = _reference(session, s, vol)
+    surf = session.surface(s)
+    lo, hi = (-s.db_range, 0.0) if s.scale == "db" else (0.0, 1.0)
+    label = "|E| (dB re sweep peak)" if s.scale == "db" else "|E| / sweep peak"
+    fig = Figure(figsize=(13, 4.6), layout="constrained")
+    axs = fig.subplots(1, 3, width_ratios=[1.1, 1, 1])
+    plane = scaled(np.abs(img.data), ref, s.scale, s.db_range)
+    m = axs[0].pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, plane, cmap="inferno",
+                          vmin=lo, vmax=hi, shading="flat")
+    axs[0].set_aspect("equal")
+    axs[0].set_xlabel("x (cm)")
+    axs[0].set_ylabel("y (cm)")
+    pk = peak_of(img, ref)
+    if s.plane == "mirror":
+        axs[0].set_title(f"mirror-source plane, range {float(img.z[0]) * CM:.1f} cm")
+    else:
+        word = "depth" if s.ground is not None else "range"
+        axs[0].set_title(f"{word} {(float(img.z[0]) - surf) * CM:.1f} cm; peak "
+                         f"({pk.x * CM:.1f}, {pk.y * CM:.1f}) cm, {pk.level_db:.1f} dB")
+    if session.kind != "survey":
+        x, y = s.section if s.section is not None else peak_position(vol)[:2]
+        xz, yz = sections(vol, x, y)
+        zlab = "depth (cm)" if s.ground is not None else "range z (cm)"
+        for ax, a, c, name, at in ((axs[1], xz, vol.x, "x", f"y = {y * CM:.1f}"),
+                                   (axs[2], yz, vol.y, "y", f"x = {x * CM:.1f}")):
+            ax.pcolormesh(_edges(c) * CM, _edges(vol.z - surf) * CM,
+                          scaled(a, ref, s.scale, s.db_range), cmap="inferno", vmin=lo,
+                          vmax=hi, shading="flat")
+            ax.invert_yaxis()
+            if s.plane != "mirror":
+                ax.axhline((float(img.z[0]) - surf) * CM, color="cyan", ls="--", lw=0.8)
+            ax.set_xlabel(f"{name} (cm)")
+            ax.set_ylabel(zlab)
+            ax.set_title(f"{name}-z section at {at} cm")
+    else:
+        for ax in axs[1:]:
+            ax.set_axis_off()
+    fig.colorbar(m, ax=axs, label=label, shrink=0.9)
+    glare = "" if s.glare == "off" else f", glare removed ({s.glare})"
+    n = len(session.selected(s)) if session.kind == "holograms" else 1
+    fig.suptitle(f"{', '.join(p.name for p in session.paths)}: {n} view(s), {s.mode}"
+                 f"{glare}")
+    return fig
+
+
+def look_history(s: ViewSettings) -> list[dict[str, Any]]:
+    """The history entry saved with an exported image: the settings as TOML text."""
+    return [{"step": "view", "parameters": {"settings_toml": settings_toml(s)}}]
+
+
+def export_png(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
+    """Write the look as a PNG into ``folder`` under a new name; returns the path."""
+    from ..atomic import write_atomic
+    from ..plotting import to_png
+
+    return write_atomic(_free_name(folder, _stem(session, s), ".png"),
+                        to_png(look_figure(session, s)))
+
+
+def export_netcdf(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
+    """Write the shown plane (complex image) as NetCDF into ``folder``; returns the path."""
+    from ...io import save
+
+    return save(session.image(s), _free_name(folder, _stem(session, s), ".nc"),
+                history=look_history(s))
+
+
+def export_settings(s: ViewSettings, folder: Path) -> Path:
+    """Write the settings TOML (``holoradar render`` reads it) into ``folder``."""
+    from ..atomic import write_atomic
+
+    stem = Path(s.files[0]).stem if s.files else "view"
+    p = _free_name(folder, f"{stem}_look", ".toml")
+    return write_atomic(p, settings_toml(s, relative_to=folder).encode())

@@ -1,0 +1,551 @@
+"""The viewer's page: Bokeh widgets and plots bound to a :class:`ViewSession`.
+
+Every picture comes from the session (holoradar's imaging in this process);
+the page only draws the arrays it is sent over the Bokeh websocket. A setting
+that changes the data (ground, glare, views, frequency, sweep) redoes the depth
+sweep behind the sections and the colour scale; the depth slider re-images one
+plane. Slider events that arrive while a plane is being imaged are merged:
+the next picture is for the latest depth, never a queue of stale ones.
+"""
+
+from __future__ import annotations
+
+import math
+import traceback
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .display import CM, db, distance, peak_of, scaled, sections
+from .session import ViewSession
+from .settings import GLARE_METHODS, MODES, ViewSettings
+
+__all__ = ["ViewerPage"]
+
+_GLARE_LABELS = {"off": "off", "gaussian": "Gaussian beam fit", "image_source": "image source",
+                 "cut": "mirror-plane cut"}
+
+
+def _edges(c: np.ndarray, unit: float = CM) -> tuple[float, float]:
+    """Left edge and width of pixels centred on ``c``, times ``unit`` (default: in cm)."""
+    step = float(c[1] - c[0]) if c.size > 1 else 1e-3
+    return float((c[0] - step / 2) * unit), float(step * c.size * unit)
+
+
+def _fmt_eps(e: complex | None, std: tuple[float, float] | None) -> str:
+    if e is None:
+        return "-"
+    if std is None:
+        return f"{e.real:.3g}{e.imag:+.2g}j"
+    return f"{e.real:.3g} ± {std[0]:.2g}, {e.imag:+.2g} ± {std[1]:.2g}j"
+
+
+class ViewerPage:
+    """One browser tab: the widgets, the figures and the callbacks that join them.
+
+    Parameters
+    ----------
+    doc : bokeh.document.Document
+        The tab's document.
+    session : ViewSession
+        The data (shared between tabs; its caches too).
+    settings : ViewSettings
+        The first look.
+    export_dir : Path
+        Where the export buttons write (never replacing a file).
+    ground_file : Mapping, optional
+        A layered ground read from a TOML medium file, offered as a choice.
+    """
+
+    def __init__(self, doc: Any, session: ViewSession, settings: ViewSettings,
+                 export_dir: Path, ground_file: dict[str, Any] | None = None) -> None:
+        self.doc = doc
+        self.session = session
+        self.s = settings
+        self.export_dir = export_dir
+        self.ground_file = ground_file
+        self.ref = 1.0
+        self.volume = None
+        self.plane = None
+        self.points: list[tuple[float, float, float]] = []
+        self.pending_plane = False
+        self.pending_full = False
+        self.frames = 0
+        self._build()
+        self._full()
+
+    # ------------------------------------------------------------------ layout
+    def _build(self) -> None:
+        from bokeh.layouts import column, row
+        from bokeh.models import (
+            Button,
+            CheckboxGroup,
+            ColorBar,
+            ColumnDataSource,
+            CustomJS,
+            Div,
+            HoverTool,
+            LinearColorMapper,
+            RadioButtonGroup,
+            Select,
+            Slider,
+            Span,
+            Spinner,
+        )
+        from bokeh.plotting import figure
+
+        s, S = self.s, self.session
+        holo = S.kind == "holograms"
+        self.status = Div(text="", name="status", width=330)
+        self.info = Div(text=self._info_text(), name="info", width=330)
+        a, b = s.sweep if s.sweep is not None else (0.0, 0.25)
+        label = "depth below the surface (cm)" if s.ground is not None else "range z (cm)"
+        step = max((b - a) / 500, 1e-4)
+        self.depth = Slider(title=label, start=a * CM, end=b * CM, step=step * CM,
+                            value=min(max(s.depth, a), b) * CM, name="depth", width=320)
+        self.depth.on_change("value", lambda _a, _o, _n: self._schedule_plane())
+        self.sweep_a = Spinner(title="sweep from (cm)", value=a * CM, step=0.5, width=100,
+                               name="sweep_a")
+        self.sweep_b = Spinner(title="to (cm)", value=b * CM, step=0.5, width=100,
+                               name="sweep_b")
+        for w in (self.sweep_a, self.sweep_b):
+            w.on_change("value", lambda _a, _o, _n: self._set_sweep())
+        # ground
+        g = dict(s.ground) if s.ground is not None else {}
+        opts = ["air (no ground)", "half-space"] + (["layers from file"] if self.ground_file
+                                                     else [])
+        kind = "air (no ground)" if s.ground is None else (
+            "layers from file" if "layer" in g else "half-space")
+        self.ground_kind = Select(title="ground", options=opts, value=kind, name="ground",
+                                  width=150)
+        eps = complex(str(g.get("eps", "2.5")).replace(" ", "").replace("i", "j")) \
+            if "layer" not in g else 2.5
+        self.surface = Spinner(title="surface range (cm)", value=float(g.get("surface", 0.3)) * CM,
+                               step=0.5, low=0.1, width=110, name="surface")
+        self.eps_re = Spinner(title="eps'", value=eps.real, step=0.1, low=1.0, width=80,
+                              name="eps_re")
+        self.eps_im = Spinner(title="eps''", value=eps.imag, step=0.01, low=0.0, width=80,
+                              name="eps_im")
+        for w in (self.ground_kind, self.surface, self.eps_re, self.eps_im):
+            w.on_change("value", lambda _a, _o, _n: self._set_ground())
+        # display
+        self.scale = RadioButtonGroup(labels=["dB", "linear"], active=0 if s.scale == "db" else 1,
+                                      name="scale")
+        self.scale.on_change("active", lambda _a, _o, _n: self._set(
+            scale="db" if self.scale.active == 0 else "linear"))
+        self.db_range = Spinner(title="dB range", value=s.db_range, step=5, low=1, high=200,
+                                width=90, name="db_range")
+        self.db_range.on_change("value", lambda _a, _o, n: self._set(db_range=float(n)))
+        self.which = RadioButtonGroup(labels=["image plane", "mirror-source plane"],
+                                      active=0 if s.plane == "image" else 1, name="plane")
+        self.which.on_change("active", lambda _a, _o, n: self._set(
+            plane="image" if n == 0 else "mirror"))
+        # glare
+        self.glare = Select(title="glare suppression", value=s.glare, name="glare",
+                            options=[(m, _GLARE_LABELS[m]) for m in GLARE_METHODS], width=170)
+        self.glare.on_change("value", lambda _a, _o, n: self._set(glare=n))
+        self.direct = CheckboxGroup(labels=["remove the direct wave too"],
+                                    active=[0] if s.direct else [], name="direct")
+        self.direct.on_change("active", lambda _a, _o, n: self._set(direct=bool(n)))
+        self.glare_report = Div(text="", name="glare_report", width=330)
+        # views and frequencies
+        names = S.names if holo else []
+        use = list(range(len(names))) if s.views is None else list(s.views)
+        self.views = CheckboxGroup(labels=names, active=use, name="views")
+        self.views.on_change("active", lambda _a, _o, n: self._set_views(n))
+        self.mode = Select(title="synthesis", options=list(MODES), value=s.mode, name="mode",
+                           width=150)
+        self.mode.on_change("value", lambda _a, _o, n: self._set(mode=n))
+        fopts = [("coherent", "all, coherent sum"), ("incoherent", "all, incoherent sum")]
+        fopts += [(str(i), f"{f / 1e9:.4g} GHz") for i, f in enumerate(S.frequencies)]
+        self.freq = Select(title="frequencies", options=fopts, value=str(s.frequency),
+                           name="frequency", width=150)
+        self.freq.on_change("value", lambda _a, _o, n: self._set(
+            frequency=n if n in ("coherent", "incoherent") else int(n)))
+        self.frame = Select(title="planes", value=s.frame, name="frame", width=150,
+                            options=[("aperture", "parallel to the array"),
+                                     ("ground", "level (ground frame)")])
+        self.frame.on_change("value", lambda _a, _o, n: self._set(frame=n))
+        # clicks
+        self.click = RadioButtonGroup(labels=["click measures", "click places sections"],
+                                      active=0, name="click")
+        self.readout = Div(text="cursor: -", name="readout", width=330)
+        self.peak = Div(text="", name="peak", width=330)
+        self.ruler = Div(text="distance: click two points", name="distance", width=330)
+        clear = Button(label="clear points", width=100, name="clear")
+        clear.on_click(lambda: self._clear_points())
+        # export
+        self.exported = Div(text="", name="exported", width=330)
+        buttons = []
+        for what in ("PNG", "NetCDF", "settings"):
+            bt = Button(label=f"export {what}", width=105, name=f"export_{what.lower()}")
+            bt.on_click(lambda _e=None, w=what: self._export(w))
+            buttons.append(bt)
+        # figures
+        self.mapper = LinearColorMapper(palette="Inferno256", low=-s.db_range, high=0.0)
+        self.src = ColumnDataSource(data={"image": [np.zeros((2, 2), np.float32)],
+                                          "db": [np.zeros((2, 2), np.float32)],
+                                          "x": [0.0], "y": [0.0], "dw": [1.0], "dh": [1.0]},
+                                    name="image_source")
+        tools = "pan,wheel_zoom,box_zoom,reset,save,tap"
+        self.fig = figure(title="plan view", width=520, height=480, tools=tools,
+                          match_aspect=True, x_axis_label="x (cm)", y_axis_label="y (cm)",
+                          name="plan")
+        self.fig.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.src,
+                       color_mapper=self.mapper)
+        self.bar = ColorBar(color_mapper=self.mapper, title="|E| (dB re sweep peak)",
+                            width=12)
+        self.fig.add_layout(self.bar, "right")
+        self.fig.add_tools(HoverTool(tooltips=[("x, y", "$x{0.0}, $y{0.0} cm"),
+                                               ("|E|", "@db{0.0} dB")]))
+        self.marks = ColumnDataSource(data={"x": [], "y": []}, name="marks")
+        self.fig.scatter("x", "y", source=self.marks, size=9, marker="x", color="cyan",
+                         line_width=2)
+        self.fig.line("x", "y", source=self.marks, color="cyan", line_dash="dashed")
+        self.vline = Span(location=0, dimension="height", line_color="white",
+                          line_dash="dotted", line_alpha=0.6)
+        self.hline = Span(location=0, dimension="width", line_color="white",
+                          line_dash="dotted", line_alpha=0.6)
+        self.fig.add_layout(self.vline)
+        self.fig.add_layout(self.hline)
+        self.fig.on_event("tap", self._tap)
+        self.xz_src = ColumnDataSource(data={"image": [np.zeros((2, 2), np.float32)],
+                                             "x": [0.0], "y": [0.0], "dw": [1], "dh": [1]})
+        self.yz_src = ColumnDataSource(data=dict(self.xz_src.data))
+        ylabel = "depth (cm)" if s.ground is not None else "range z (cm)"
+        self.xz = figure(title="x-z section", width=420, height=230, x_axis_label="x (cm)",
+                         y_axis_label=ylabel, tools="pan,wheel_zoom,reset,save", name="xz")
+        self.yz = figure(title="y-z section", width=420, height=230, x_axis_label="y (cm)",
+                         y_axis_label=ylabel, tools="pan,wheel_zoom,reset,save", name="yz")
+        self.depth_marks = []
+        for f, src in ((self.xz, self.xz_src), (self.yz, self.yz_src)):
+            f.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src,
+                    color_mapper=self.mapper)
+            f.y_range.flipped = True
+            sp = Span(location=0, dimension="width", line_color="cyan", line_dash="dashed")
+            f.add_layout(sp)
+            self.depth_marks.append(sp)
+        # hologram and spectral window of one view
+        self.holo_view = Select(title="hologram of view", options=[(str(i), n) for i, n in
+                                                                   enumerate(names)],
+                                value="0", name="holo_view", width=200)
+        self.holo_view.on_change("value", lambda _a, _o, _n: self._holo())
+        self.h_amp = ColumnDataSource(data=dict(self.xz_src.data))
+        self.h_phase = ColumnDataSource(data=dict(self.xz_src.data))
+        self.h_spec = ColumnDataSource(data=dict(self.xz_src.data))
+        self.hfigs = []
+        for title, src, pal, lab in (
+                ("amplitude |E|", self.h_amp, "Viridis256", ("x (cm)", "y (cm)")),
+                ("phase (rad)", self.h_phase, "Turbo256", ("x (cm)", "y (cm)")),
+                ("spectral window |FFT| (dB)", self.h_spec, "Magma256",
+                 ("kx / k", "ky / k"))):
+            f = figure(title=title, width=280, height=260, tools="pan,wheel_zoom,reset,save",
+                       match_aspect=True, x_axis_label=lab[0], y_axis_label=lab[1])
+            m = LinearColorMapper(palette=pal)
+            f.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src, color_mapper=m)
+            f.add_layout(ColorBar(color_mapper=m, width=8), "right")
+            self.hfigs.append(f)
+        t = np.linspace(0, 2 * np.pi, 181)
+        self.hfigs[2].line(np.cos(t), np.sin(t), color="white", line_dash="dashed",
+                           legend_label="|k_t| = k")
+        self.hfigs[2].legend.location = "top_left"
+        self.hfigs[2].legend.background_fill_alpha = 0.3
+        # the cursor readout: x, y from the pointer, the value from the shown plane
+        self.fig.js_on_event("mousemove", CustomJS(args={"src": self.src, "div": self.readout,
+                                                         "depth": self.depth}, code="""
+            const d = src.data; const w = d.dw[0], h = d.dh[0];
+            const shape = d.db[0].shape || [0, 0];
+            const i = Math.floor((cb_obj.y - d.y[0]) / h * shape[0]);
+            const j = Math.floor((cb_obj.x - d.x[0]) / w * shape[1]);
+            let v = '-';
+            if (i >= 0 && j >= 0 && i < shape[0] && j < shape[1]) {
+                v = Number(d.db[0][i * shape[1] + j]).toFixed(1) + ' dB';
+            }
+            div.text = `cursor: x = ${cb_obj.x.toFixed(1)} cm, y = ${cb_obj.y.toFixed(1)} cm, `
+                     + `depth = ${depth.value.toFixed(1)} cm, |E| = ${v}`;
+        """))
+        controls = column(
+            self.info, self.status, self.depth, row(self.sweep_a, self.sweep_b),
+            row(self.ground_kind, self.surface), row(self.eps_re, self.eps_im),
+            self.glare, self.direct, self.glare_report, self.which,
+            Div(text="<b>views</b>"), self.views, row(self.mode, self.freq), self.frame,
+            row(self.scale, self.db_range), self.click, clear, row(*buttons[:2]),
+            buttons[2], self.exported, width=340)
+        readouts = column(self.peak, self.readout, self.ruler)
+        holo_row = row(column(self.holo_view, self.hfigs[0]), self.hfigs[1], self.hfigs[2])
+        layout = row(controls, column(row(column(self.fig, readouts),
+                                          column(self.xz, self.yz)), holo_row))
+        if not holo:
+            for w in (self.ground_kind, self.surface, self.eps_re, self.eps_im, self.glare,
+                      self.direct, self.which, self.mode, self.freq, self.frame,
+                      self.holo_view):
+                w.disabled = True
+        self.doc.add_root(layout)
+        self.doc.title = f"holoradar view: {', '.join(p.name for p in S.paths)}"
+
+    def _info_text(self) -> str:
+        S = self.session
+        if S.kind == "survey":
+            what = f"survey store, {len(S.names)} frames"
+        elif S.kind == "image":
+            v = S.volume
+            what = (f"image, {v.z.size} plane(s) {v.z.min() * CM:.1f} to {v.z.max() * CM:.1f} "
+                    "cm")
+        else:
+            h = S.views[0]
+            f = S.frequencies
+            fs = f"{f[0] / 1e9:.4g} GHz" if f.size == 1 else \
+                f"{f.size} frequencies {f[0] / 1e9:.4g} to {f[-1] / 1e9:.4g} GHz"
+            what = (f"{len(S.views)} view(s), {h.x.size} x {h.y.size} elements, pitch "
+                    f"{h.pitch[0] * CM:.3g} cm, {fs}"
+                    + (", tilted array" if S.tilted else ""))
+        return f"<b>{', '.join(p.name for p in S.paths)}</b><br>{what}"
+
+    # ------------------------------------------------------------- settings
+    def _set(self, **changes: Any) -> None:
+        try:
+            self.s = self.s.replace(**changes)
+        except ValueError as exc:
+            self._error(str(exc))
+            return
+        light = set(changes) <= {"scale", "db_range"}
+        if light:
+            self._recolour()
+        else:
+            self._schedule_full()
+
+    def _set_views(self, active: list[int]) -> None:
+        if not active:
+            self._error("views: keep at least one view")
+            return
+        self._set(views=tuple(sorted(active)))
+
+    def _set_sweep(self) -> None:
+        a, b = self.sweep_a.value, self.sweep_b.value
+        if a is None or b is None or not b > a:
+            self._error("sweep: 'to' must be below 'from'")
+            return
+        self.depth.start, self.depth.end = a, b
+        self.depth.step = max((b - a) / 500, 0.01)
+        self.depth.value = min(max(self.depth.value, a), b)
+        self._set(sweep=(a / CM, b / CM))
+
+    def _set_ground(self) -> None:
+        kind = self.ground_kind.value
+        if kind == "air (no ground)":
+            ground = None
+        elif kind == "layers from file":
+            ground = self.ground_file
+        else:
+            try:
+                ground = {"surface": float(self.surface.value) / CM,
+                          "eps": f"{float(self.eps_re.value)}+{float(self.eps_im.value)}j"}
+            except (TypeError, ValueError):
+                self._error("ground: give the surface range and eps', eps''")
+                return
+        self.depth.title = "depth below the surface (cm)" if ground is not None \
+            else "range z (cm)"
+        for f in (self.xz, self.yz):
+            f.yaxis.axis_label = "depth (cm)" if ground is not None else "range z (cm)"
+        self._set(ground=ground)
+
+    def _error(self, text: str) -> None:
+        self.status.text = f'<span style="color:#b00">{text}</span>'
+
+    # ------------------------------------------------------------- scheduling
+    def _schedule_full(self) -> None:
+        if not self.pending_full:
+            self.pending_full = True
+            self.status.text = "imaging the sweep ..."
+            self.doc.add_next_tick_callback(self._full)
+
+    def _schedule_plane(self) -> None:
+        if not self.pending_plane:
+            self.pending_plane = True
+            self.doc.add_next_tick_callback(self._plane)
+
+    def _guard(self, work: Any) -> bool:
+        try:
+            work()
+        except ValueError as exc:
+            self._error(str(exc))
+            return False
+        except Exception as exc:  # a bug must show, not freeze the page
+            traceback.print_exc()
+            self._error(f"internal error: {type(exc).__name__}: {exc}")
+            return False
+        return True
+
+    # ------------------------------------------------------------- pictures
+    def _full(self) -> None:
+        self.pending_full = False
+        if self._guard(self._compute_full):
+            self.status.text = ""
+        self._plane()
+
+    def _compute_full(self) -> None:
+        S, s = self.session, self.s
+        self.volume = S.sweep(s)
+        self.ref = float(np.abs(self.volume.data).max()) or 1.0
+        if s.plane == "mirror":
+            raw = S.mirror_plane(s.replace(glare="off"))
+            self.ref = float(np.abs(raw.data).max()) or 1.0
+        self._glare()
+        self._holo()
+        self._sections()
+
+    def _plane(self) -> None:
+        self.pending_plane = False
+        self.s = self.s.replace(depth=float(self.depth.value) / CM)
+        if self._guard(self._compute_plane):
+            if self.status.text.startswith('<span style="color:#b00">'):
+                self.status.text = ""
+
+    def _compute_plane(self) -> None:
+        S, s = self.session, self.s
+        img = S.image(s)
+        self.plane = img
+        amp = np.abs(img.data)
+        shown = scaled(amp, self.ref, s.scale, s.db_range).astype(np.float32)
+        x0, w = _edges(img.x)
+        y0, h = _edges(img.y)
+        self.src.data = {"image": [shown], "db": [db(amp, self.ref).astype(np.float32)],
+                         "x": [x0], "y": [y0], "dw": [w], "dh": [h]}
+        self.frames += 1
+        surf = S.surface(s)
+        pk = peak_of(img, self.ref)
+        if s.plane == "mirror":
+            self.fig.title.text = f"mirror-source plane, range {float(img.z[0]) * CM:.1f} cm"
+        else:
+            where = "depth" if s.ground is not None else "range"
+            self.fig.title.text = f"{where} {(float(img.z[0]) - surf) * CM:.1f} cm"
+        self.peak.text = (f"peak: x = {pk.x * CM:.2f} cm, y = {pk.y * CM:.2f} cm, "
+                          f"{'depth' if s.ground is not None else 'range'} = "
+                          f"{(pk.z - (0 if s.plane == 'mirror' else surf)) * CM:.2f} cm, "
+                          f"|E| = {pk.level_db:.1f} dB")
+        for sp in self.depth_marks:
+            sp.location = self.depth.value
+        self._recolour_mapper()
+
+    def _recolour_mapper(self) -> None:
+        s = self.s
+        if s.scale == "db":
+            self.mapper.low, self.mapper.high = -s.db_range, 0.0
+            self.bar.title = ("|E| (dB re the unsuppressed glare)" if s.plane == "mirror"
+                              else "|E| (dB re sweep peak)")
+        else:
+            self.mapper.low, self.mapper.high = 0.0, 1.0
+            self.bar.title = "|E| / sweep peak"
+
+    def _recolour(self) -> None:
+        self._guard(self._sections)
+        self._plane()
+
+    def _sections(self) -> None:
+        S, s, vol = self.session, self.s, self.volume
+        if vol is None:
+            return
+        if S.kind == "survey":
+            for src in (self.xz_src, self.yz_src):
+                src.data = {"image": [np.zeros((2, 2), np.float32)], "x": [0.0], "y": [0.0],
+                            "dw": [1.0], "dh": [1.0]}
+            self.xz.title.text = self.yz.title.text = "sections: not for a survey mosaic"
+            return
+        if s.section is not None:
+            x, y = s.section
+        else:
+            from ...analysis.metrics import peak_position
+
+            x, y, _ = peak_position(vol)
+        xz, yz = sections(vol, x, y)
+        surf = S.surface(s)
+        z0, dz = _edges(vol.z - surf)
+        for src, a, c in ((self.xz_src, xz, vol.x), (self.yz_src, yz, vol.y)):
+            c0, w = _edges(c)
+            src.data = {"image": [scaled(a, self.ref, s.scale, s.db_range).astype(np.float32)],
+                        "x": [c0], "y": [z0], "dw": [w], "dh": [dz]}
+        self.xz.title.text = f"x-z section at y = {y * CM:.1f} cm"
+        self.yz.title.text = f"y-z section at x = {x * CM:.1f} cm"
+        self.vline.location, self.hline.location = x * CM, y * CM
+
+    def _holo(self) -> None:
+        S, s = self.session, self.s
+        if S.kind != "holograms":
+            return
+        i = int(self.holo_view.value)
+        h = S.hologram(s, i)
+        x0, w = _edges(h.x)
+        y0, hh = _edges(h.y)
+        d = h.data
+        self.h_amp.data = {"image": [np.abs(d).astype(np.float32)], "x": [x0], "y": [y0],
+                           "dw": [w], "dh": [hh]}
+        self.h_phase.data = {"image": [np.angle(d).astype(np.float32)], "x": [x0],
+                             "y": [y0], "dw": [w], "dh": [hh]}
+        kx, ky, spec = S.spectrum(s, i)
+        sdb = scaled(spec, float(spec.max()), "db", 40.0).astype(np.float32)
+        kx0, kw = _edges(kx, 1.0)
+        ky0, kh = _edges(ky, 1.0)
+        self.h_spec.data = {"image": [sdb], "x": [kx0], "y": [ky0], "dw": [kw], "dh": [kh]}
+        state = "after glare suppression" if s.glare != "off" else "as recorded"
+        self.hfigs[0].title.text = f"amplitude |E|, {state}"
+
+    def _glare(self) -> None:
+        S, s = self.session, self.s
+        if S.kind != "holograms" or s.glare == "off":
+            self.glare_report.text = ""
+            return
+        _, notes = S.cleaned(s)
+        rows = []
+        for n in notes:
+            if n.error is not None:
+                rows.append(f"<tr><td>{n.view}</td><td colspan=3 style='color:#b00'>"
+                            f"{n.error}</td></tr>")
+                continue
+            rows.append(f"<tr><td>{n.view}</td><td>{n.removed_db:.1f}</td>"
+                        f"<td>{n.suppression_db:.1f}</td>"
+                        f"<td>{_fmt_eps(n.eps, n.eps_std)}</td></tr>")
+        self.glare_report.text = (
+            "<table><tr><th>view</th><th>removed (dB)</th><th>spot drop (dB)</th>"
+            "<th>eps from glare</th></tr>" + "".join(rows) + "</table>")
+
+    # ------------------------------------------------------------- clicks
+    def _tap(self, event: Any) -> None:
+        x, y = float(event.x) / CM, float(event.y) / CM
+        if not (math.isfinite(x) and math.isfinite(y)):
+            return
+        if self.click.active == 1:
+            self._set(section=(x, y))
+            return
+        self.points = [*self.points[-1:], (x, y, float(self.depth.value) / CM)]
+        self.marks.data = {"x": [p[0] * CM for p in self.points],
+                           "y": [p[1] * CM for p in self.points]}
+        if len(self.points) == 2:
+            p, q = self.points
+            d = distance(p, q)
+            self.ruler.text = (f"distance: {d * CM:.2f} cm (dx {abs(q[0] - p[0]) * CM:.2f}, "
+                               f"dy {abs(q[1] - p[1]) * CM:.2f}, d(depth) "
+                               f"{abs(q[2] - p[2]) * CM:.2f} cm)")
+        else:
+            self.ruler.text = "distance: click a second point"
+
+    def _clear_points(self) -> None:
+        self.points = []
+        self.marks.data = {"x": [], "y": []}
+        self.ruler.text = "distance: click two points"
+
+    # ------------------------------------------------------------- export
+    def _export(self, what: str) -> None:
+        from .export import export_netcdf, export_png, export_settings
+
+        try:
+            if what == "PNG":
+                p = export_png(self.session, self.s, self.export_dir)
+            elif what == "NetCDF":
+                p = export_netcdf(self.session, self.s, self.export_dir)
+            else:
+                p = export_settings(self.s, self.export_dir)
+        except (ValueError, OSError) as exc:
+            self._error(f"export {what}: {exc}")
+            return
+        self.exported.text = f"wrote {p}"

@@ -1,0 +1,111 @@
+"""Serve the viewer: a Bokeh server in this process, bound to the loopback by default.
+
+Why Bokeh: one well-kept dependency (Bokeh on Tornado) that starts in about a
+second, keeps the imaging in this Python process and sends each new picture
+to the page as a binary array over its websocket (no image encoding, no
+polling); its widgets, hover readout and colour bars are what the page needs.
+The server serves BokehJS's own static files and the page: no route takes a
+path from a request, so only the files given on the command line are read.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import warnings
+import webbrowser
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from .session import ViewSession
+from .settings import ViewSettings
+
+__all__ = ["is_loopback", "make_server", "open_in_browser", "url_of"]
+
+
+def is_loopback(host: str) -> bool:
+    """True for 127.0.0.0/8, ::1 and ``localhost``.
+
+    Examples
+    --------
+    >>> is_loopback("127.0.0.1"), is_loopback("0.0.0.0"), is_loopback("localhost")
+    (True, False, True)
+    """
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "127.0.0.1",
+                port: int = 0, export_dir: Path | None = None,
+                ground_file: dict[str, Any] | None = None) -> Any:
+    """A started ``bokeh.server.server.Server`` showing ``session`` at ``/``.
+
+    Parameters
+    ----------
+    session, settings
+        The data and the first look (each new tab starts from it).
+    host : str
+        Address to bind; a non-loopback one exposes the data to the network
+        (a :class:`UserWarning` says so).
+    port : int
+        0 (default): a free port chosen by the system (``server.port``).
+    export_dir : Path
+        Where the page's export buttons write; default the current folder.
+
+    Returns
+    -------
+    bokeh.server.server.Server
+        Started; run ``server.io_loop.start()`` to serve (blocks), ``server.stop()``
+        to end.
+    """
+    from bokeh.application import Application
+    from bokeh.application.handlers.function import FunctionHandler
+    from bokeh.server.server import Server
+
+    from .page import ViewerPage
+
+    if not is_loopback(host):
+        warnings.warn(f"serving on {host}, not the loopback: anyone who can reach this "
+                      "machine can see the data and use the page", UserWarning, stacklevel=2)
+    folder = Path.cwd() if export_dir is None else Path(export_dir)
+
+    def make_doc(doc: Any) -> None:
+        ViewerPage(doc, session, settings, folder, ground_file)
+
+    app = Application(FunctionHandler(make_doc))
+    if not port:
+        port = _free_port(host)
+    shown = f"[{host}]" if ":" in host else host
+    origins = [f"{shown}:{port}"] + ([f"localhost:{port}"] if is_loopback(host) else [])
+    server = Server({"/": app}, address=host, port=port, allow_websocket_origin=origins,
+                    num_procs=1)
+    server.start()
+    return server
+
+
+def _free_port(host: str) -> int:
+    """A port the system says is free on ``host`` (taken again at once by the server)."""
+    import socket
+
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    with socket.socket(family, socket.SOCK_STREAM) as sock:
+        sock.bind((host, 0))
+        return int(sock.getsockname()[1])
+
+
+def url_of(server: Any, host: str) -> str:
+    """The page's address."""
+    shown = f"[{host}]" if ":" in host else host
+    return f"http://{shown}:{server.port}/"
+
+
+def open_in_browser(url: str, opener: Callable[[str], Any] = webbrowser.open) -> None:
+    """Open ``url`` in the user's browser (nothing happens where there is none)."""
+    try:
+        opener(url)
+    except Exception:  # no browser on a headless machine: the URL was printed
+        pass
