@@ -33,7 +33,9 @@ from typing import Literal
 import numpy as np
 
 from ..data.hologram import Hologram, Image
+from ..physics.incident import incident_phasors
 from ..physics.medium import Medium
+from ..physics.sources import PlaneWave
 from .migrate import _incident_phasor, migrate
 
 __all__ = ["align_phases", "synthesize"]
@@ -194,12 +196,16 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     img = migrate(stack, z, medium=medium, upsample=upsample, fov=fov, **where)
     g = img.data if img.has_z_axis else img.data[:, None]
     k = views[0].k
-    aligned = np.empty_like(g)
-    for i, v in enumerate(views):
-        # conj(E0)/|E0|, the unit phasor of the incident field (0 where it vanishes),
-        # at the pixels' world positions (a raised or shifted level view included).
-        aligned[i] = g[i] * _incident_phasor(v.source, k, med, img,
-                                             None if frame == "ground" else v.pose)
+    # conj(E0)/|E0|, the unit phasor of the incident field (0 where it vanishes),
+    # at the pixels' world positions (a raised or shifted level view included).
+    if frame == "ground" or all(v.pose.is_identity for v in views):
+        sources = [v.source if v.source is not None else PlaneWave() for v in views]
+        aligned = np.multiply(g, incident_phasors(sources, k, med, img.x, img.y, img.z),
+                              out=np.empty_like(g))
+    else:
+        aligned = np.empty_like(g)
+        for i, v in enumerate(views):
+            aligned[i] = g[i] * _incident_phasor(v.source, k, med, img, v.pose)
     return _combine(aligned, img, mode, return_views)
 
 

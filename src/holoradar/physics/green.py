@@ -335,6 +335,8 @@ def transmitted_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarr
         J = _bessel_matrix(rho, kap)                                # (nrho, nkappa)
         f = 1j * medium.vertical_transfers(k, k2, z_src, z_obs[deep]) * (
             kap / medium.kz(k, k2, 0))                               # (nz, nkappa)
-        acc += (f * w) @ J.T
+        fw = f * w
+        # Real matrix products: a complex @ real product would first copy J to complex.
+        acc += fw.real @ J.T + 1j * (fw.imag @ J.T)
     out[deep] = acc
     return out

@@ -17,7 +17,7 @@ from .green import free_space_green, layered_green, transmitted_profiles
 from .medium import Medium
 from .sources import GaussianBeam, PlaneWave, PointSource, ray_direction
 
-__all__ = ["incident_on_plane", "incident_on_planes"]
+__all__ = ["incident_on_plane", "incident_on_planes", "incident_phasors"]
 
 _RADIAL_STEP_WAVELENGTHS = 1 / 16
 
@@ -111,3 +111,67 @@ def incident_on_planes(source: object, k: float, medium: Medium, x: np.ndarray, 
             e0 = e0 * source.pattern(ray_direction(k, medium, src, pts)).reshape(X.shape)
         out[j] = e0
     return out
+
+
+def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndarray,
+                     y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Unit phasors ``conj(E0)/|E0|`` of several sources on the same planes (0 where
+    ``E0`` vanishes), shape (len(sources), len(z), y.size, x.size).
+
+    This is what multi-view synthesis multiplies each view's image by. Point
+    sources at one height above layered ground share one Sommerfeld quadrature
+    (:func:`~holoradar.physics.green.transmitted_profiles` on a radial grid long
+    enough for all of them): their radial profiles differ only by the lateral
+    shift of the source. Other sources go through :func:`incident_on_planes` one
+    by one.
+
+    Examples
+    --------
+    >>> m = Medium.half_space(0.3, 2.5)
+    >>> srcs = [PointSource((0.0, -0.2, 0.0)), PointSource((0.1, 0.2, 0.0))]
+    >>> xs = np.linspace(-0.1, 0.1, 5)
+    >>> u = incident_phasors(srcs, 200.0, m, xs, xs, np.array([0.4]))
+    >>> e = incident_on_plane(srcs[1], 200.0, m, xs, xs, 0.4)
+    >>> bool(np.allclose(u[1, 0], e.conj() / abs(e), atol=1e-9))
+    True
+    """
+    zs = np.atleast_1d(np.asarray(z, dtype=float))
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    out = np.empty((len(sources), zs.size, y.size, x.size), complex)
+    shared: dict[float, list[int]] = {}
+    for i, src in enumerate(sources):
+        if isinstance(src, PointSource) and not medium.is_free_space:
+            src._check_air(medium)
+            shared.setdefault(round(float(src.position[2]), 12), []).append(i)
+        else:
+            out[i] = _unit(incident_on_planes(src, k, medium, x, y, zs))
+    if not shared:
+        return out
+    X, Y = np.meshgrid(x, y)
+    n = max(abs(medium.n(m)) for m in range(medium.n_regions))
+    step = 2 * np.pi / (k * n) * _RADIAL_STEP_WAVELENGTHS
+    for members in shared.values():
+        srcs = [sources[i] for i in members]
+        rhos = [np.hypot(X - s.position[0], Y - s.position[1]) for s in srcs]
+        r = np.arange(0.0, max(float(p.max()) for p in rhos) + 2 * step, step)
+        prof = transmitted_profiles(k, medium, float(srcs[0].position[2]), zs, r)
+        phase = np.unwrap(np.angle(prof), axis=-1)
+        vanishes = not np.all(np.abs(prof) > 0)
+        for i, s, rho in zip(members, srcs, rhos, strict=True):
+            for j, zj in enumerate(zs):
+                # Only the phase is needed: one interpolation instead of two.
+                u = np.exp(-1j * np.interp(rho, r, phase[j]))
+                if vanishes:
+                    u[np.interp(rho, r, np.abs(prof[j])) == 0] = 0
+                if s.has_pattern:
+                    pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, zj)], axis=1)
+                    u *= _unit(s.pattern(ray_direction(k, medium, s.position, pts))
+                               ).reshape(X.shape)
+                out[i, j] = u
+    return out
+
+
+def _unit(e: np.ndarray) -> np.ndarray:
+    """``conj(e)/|e|``, 0 where ``e`` is 0."""
+    mag = np.abs(e)
+    return np.divide(e.conj(), mag, out=np.zeros_like(e), where=mag > 0)

@@ -16,6 +16,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -71,25 +72,36 @@ class ViewerProcess:
         cmd = [sys.executable, "-m", "holoradar", "view", *map(str, args),
                "--no-browser", "--json"]
         env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"}
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     cwd=cwd, env=env, text=True)
-        lines = []
+        # Files, not pipes: a server that logs a lot must never block on a full pipe.
+        self._out = tempfile.TemporaryFile("w+")
+        self._err = tempfile.TemporaryFile("w+")
+        self.proc = subprocess.Popen(cmd, stdout=self._out, stderr=self._err, cwd=cwd,
+                                     env=env, text=True)
         t0 = time.monotonic()
+        self.url = ""
         while time.monotonic() - t0 < timeout:
-            line = self.proc.stdout.readline()  # type: ignore[union-attr]
-            if not line:
+            self._out.seek(0)
+            text = self._out.read()
+            if text.rstrip().endswith("}"):
+                try:
+                    self.url = json.loads(text)["url"]
+                except (json.JSONDecodeError, KeyError):
+                    break
+                return
+            if self.proc.poll() is not None:
                 break
-            lines.append(line)
-            if line.startswith("}"):
-                break
-        try:
-            self.url = json.loads("".join(lines))["url"]
-        except (json.JSONDecodeError, KeyError):
-            self.stop()
-            err = self.proc.stderr.read() if self.proc.stderr else ""  # type: ignore[union-attr]
-            raise RuntimeError(f"holoradar view did not start: {''.join(lines)} {err}") from None
+            time.sleep(0.05)
+        self.stop()
+        self._out.seek(0)
+        raise RuntimeError(f"holoradar view did not start: {self._out.read()} {self.log()}")
+
+    def log(self) -> str:
+        """What the server wrote to its standard error so far."""
+        self._err.seek(0)
+        return self._err.read()
 
     def stop(self) -> None:
+        """Stop the server (terminate, then kill after 10 s)."""
         if self.proc.poll() is None:
             self.proc.terminate()
             try:

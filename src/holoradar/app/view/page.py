@@ -86,6 +86,7 @@ class ViewerPage:
             CustomJS,
             Div,
             HoverTool,
+            Label,
             LinearColorMapper,
             RadioButtonGroup,
             Select,
@@ -171,7 +172,11 @@ class ViewerPage:
         self.click = RadioButtonGroup(labels=["click measures", "click places sections"],
                                       active=0, name="click")
         self.readout = Div(text="cursor: -", name="readout", width=330)
-        self.peak = Div(text="", name="peak", width=330)
+        # Drawn on the plot's canvas: a Div's new text would re-lay out the whole page on
+        # every slider step (about 8 ms in Chromium).
+        self.peak = Label(x=6, y=6, x_units="screen", y_units="screen", text="", name="peak",
+                          text_color="white", text_font_size="10pt",
+                          background_fill_color="black", background_fill_alpha=0.6)
         self.ruler = Div(text="distance: click two points", name="distance", width=330)
         clear = Button(label="clear points", width=100, name="clear")
         clear.on_click(lambda: self._clear_points())
@@ -197,6 +202,7 @@ class ViewerPage:
         self.bar = ColorBar(color_mapper=self.mapper, title="|E| (dB re sweep peak)",
                             width=12)
         self.fig.add_layout(self.bar, "right")
+        self.fig.add_layout(self.peak)
         self.fig.add_tools(HoverTool(tooltips=[("x, y", "$x{0.0}, $y{0.0} cm"),
                                                ("|E|", "@db{0.0} dB")]))
         self.marks = ColumnDataSource(data={"x": [], "y": []}, name="marks")
@@ -272,7 +278,7 @@ class ViewerPage:
             Div(text="<b>views</b>"), self.views, row(self.mode, self.freq), self.frame,
             row(self.scale, self.db_range), self.click, clear, row(*buttons[:2]),
             buttons[2], self.exported, width=340)
-        readouts = column(self.peak, self.readout, self.ruler)
+        readouts = column(self.readout, self.ruler)
         holo_row = row(column(self.holo_view, self.hfigs[0]), self.hfigs[1], self.hfigs[2])
         layout = row(controls, column(row(column(self.fig, readouts),
                                           column(self.xz, self.yz)), holo_row))
@@ -387,6 +393,8 @@ class ViewerPage:
     def _compute_full(self) -> None:
         S, s = self.session, self.s
         self.volume = S.sweep(s)
+        self.fig.title.text = ("mirror-source plane (the glare's focus)" if s.plane == "mirror"
+                               else "plan view at the slider's depth")
         self.ref = float(np.abs(self.volume.data).max()) or 1.0
         if s.plane == "mirror":
             raw = S.mirror_plane(s.replace(glare="off"))
@@ -398,9 +406,14 @@ class ViewerPage:
     def _plane(self) -> None:
         self.pending_plane = False
         self.s = self.s.replace(depth=float(self.depth.value) / CM)
-        if self._guard(self._compute_plane):
-            if self.status.text.startswith('<span style="color:#b00">'):
-                self.status.text = ""
+        # One message to the browser for the whole picture, not one per property.
+        self.doc.hold("combine")
+        try:
+            if self._guard(self._compute_plane):
+                if self.status.text.startswith('<span style="color:#b00">'):
+                    self.status.text = ""
+        finally:
+            self.doc.unhold()
 
     def _compute_plane(self) -> None:
         S, s = self.session, self.s
@@ -415,15 +428,12 @@ class ViewerPage:
         self.frames += 1
         surf = S.surface(s)
         pk = peak_of(img, self.ref)
-        if s.plane == "mirror":
-            self.fig.title.text = f"mirror-source plane, range {float(img.z[0]) * CM:.1f} cm"
-        else:
-            where = "depth" if s.ground is not None else "range"
-            self.fig.title.text = f"{where} {(float(img.z[0]) - surf) * CM:.1f} cm"
-        self.peak.text = (f"peak: x = {pk.x * CM:.2f} cm, y = {pk.y * CM:.2f} cm, "
-                          f"{'depth' if s.ground is not None else 'range'} = "
-                          f"{(pk.z - (0 if s.plane == 'mirror' else surf)) * CM:.2f} cm, "
-                          f"|E| = {pk.level_db:.1f} dB")
+        where = "depth" if s.ground is not None and s.plane != "mirror" else "range"
+        at = float(img.z[0]) - (surf if where == "depth" else 0.0)
+        pz = pk.z - (surf if where == "depth" else 0.0)
+        self.peak.text = (f"{where} {at * CM:.2f} cm\n"
+                          f"peak: x = {pk.x * CM:.2f} cm, y = {pk.y * CM:.2f} cm, "
+                          f"{where} = {pz * CM:.2f} cm, |E| = {pk.level_db:.1f} dB")
         for sp in self.depth_marks:
             sp.location = self.depth.value
         self._recolour_mapper()
