@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow lint bench clean browser
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -15,7 +15,23 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/holoradar demo --out demo_out --force
 
-test: $(STAMP)
+# The viewer's end-to-end tests drive Debian's headless Chromium with its chromedriver:
+# installed here when missing and this user may (root, or password-less sudo); where it
+# cannot be, those tests skip and say why.
+BROWSER_PKGS := chromium chromium-driver
+browser:
+	@if command -v chromium >/dev/null && command -v chromedriver >/dev/null; then :; \
+	elif [ "$$(id -u)" = 0 ]; then \
+	  (apt-get install -y -q $(BROWSER_PKGS) >/dev/null 2>&1 || \
+	   (apt-get update -q >/dev/null 2>&1 && apt-get install -y -q $(BROWSER_PKGS) >/dev/null)) \
+	  || echo "could not install $(BROWSER_PKGS): the browser tests will skip"; \
+	elif sudo -n true 2>/dev/null; then \
+	  sudo -n apt-get install -y -q $(BROWSER_PKGS) >/dev/null \
+	  || echo "could not install $(BROWSER_PKGS): the browser tests will skip"; \
+	else echo "$(BROWSER_PKGS) missing and not installable here: the browser tests will skip"; \
+	fi
+
+test: $(STAMP) browser
 	$(BIN)/ruff check src tests benchmarks examples
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 

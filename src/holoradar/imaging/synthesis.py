@@ -33,7 +33,7 @@ from typing import Literal
 import numpy as np
 
 from ..data.hologram import Hologram, Image
-from ..physics.incident import incident_phasors
+from ..physics.incident import remove_incident_phase
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave
 from .migrate import _incident_phasor, migrate
@@ -200,8 +200,8 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     # at the pixels' world positions (a raised or shifted level view included).
     if frame == "ground" or all(v.pose.is_identity for v in views):
         sources = [v.source if v.source is not None else PlaneWave() for v in views]
-        aligned = np.multiply(g, incident_phasors(sources, k, med, img.x, img.y, img.z),
-                              out=np.empty_like(g))
+        aligned = g  # migrate's own new array: the phase comes off in place
+        remove_incident_phase(aligned, sources, k, med, img.x, img.y, img.z)
     else:
         aligned = np.empty_like(g)
         for i, v in enumerate(views):

@@ -11,13 +11,15 @@ A Gaussian beam is summed directly.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 from .green import free_space_green, layered_green, transmitted_profiles
 from .medium import Medium
 from .sources import GaussianBeam, PlaneWave, PointSource, ray_direction
 
-__all__ = ["incident_on_plane", "incident_on_planes", "incident_phasors"]
+__all__ = ["incident_on_plane", "incident_on_planes", "incident_phasors", "remove_incident_phase"]
 
 _RADIAL_STEP_WAVELENGTHS = 1 / 16
 
@@ -118,12 +120,13 @@ def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndar
     """Unit phasors ``conj(E0)/|E0|`` of several sources on the same planes (0 where
     ``E0`` vanishes), shape (len(sources), len(z), y.size, x.size).
 
-    This is what multi-view synthesis multiplies each view's image by. Point
-    sources at one height above layered ground share one Sommerfeld quadrature
-    (:func:`~holoradar.physics.green.transmitted_profiles` on a radial grid long
-    enough for all of them): their radial profiles differ only by the lateral
-    shift of the source. Other sources go through :func:`incident_on_planes` one
-    by one.
+    This is what multi-view synthesis multiplies each view's image by
+    (:func:`remove_incident_phase` does it in place, one plane at a time, without
+    this array). Point sources at one height above layered ground share one
+    Sommerfeld quadrature (:func:`~holoradar.physics.green.transmitted_profiles`
+    on a radial grid long enough for all of them): their radial profiles differ
+    only by the lateral shift of the source. Other sources go through
+    :func:`incident_on_plane` plane by plane.
 
     Examples
     --------
@@ -136,17 +139,54 @@ def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndar
     True
     """
     zs = np.atleast_1d(np.asarray(z, dtype=float))
+    out = np.empty((len(sources), zs.size, np.size(y), np.size(x)), complex)
+    for i, j, u in _phasor_planes(sources, k, medium, x, y, zs):
+        out[i, j] = u
+    return out
+
+
+def remove_incident_phase(images: np.ndarray, sources: list[object], k: float,
+                          medium: Medium, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> None:
+    """Multiply ``images[i, j]`` (len(sources), len(z), y.size, x.size) in place by
+    source i's unit phasor ``conj(E0)/|E0|`` on the plane at range ``z[j]``.
+
+    The same phasors as :func:`incident_phasors`, made one plane at a time: a depth
+    sweep of many views never holds them all.
+
+    Examples
+    --------
+    >>> m = Medium.half_space(0.3, 2.5)
+    >>> srcs = [PointSource((0.0, -0.2, 0.0))]
+    >>> xs = np.linspace(-0.1, 0.1, 5)
+    >>> e = incident_on_plane(srcs[0], 200.0, m, xs, xs, 0.4)
+    >>> img = e[None, None].copy()
+    >>> remove_incident_phase(img, srcs, 200.0, m, xs, xs, np.array([0.4]))
+    >>> bool(np.allclose(img, abs(e), atol=1e-9))
+    True
+    """
+    zs = np.atleast_1d(np.asarray(z, dtype=float))
+    want = (len(sources), zs.size, np.size(y), np.size(x))
+    if images.shape != want:
+        raise ValueError(f"images must have shape (sources, planes, y, x) = {want}, got "
+                         f"{images.shape}")
+    for i, j, u in _phasor_planes(sources, k, medium, x, y, zs):
+        images[i, j] *= u
+
+
+def _phasor_planes(sources: list[object], k: float, medium: Medium, x: np.ndarray,
+                   y: np.ndarray, zs: np.ndarray) -> Iterator[tuple[int, int, np.ndarray]]:
+    """``(source index, plane index, unit phasor (y.size, x.size))`` for every pair."""
     x, y = np.asarray(x, float), np.asarray(y, float)
-    out = np.empty((len(sources), zs.size, y.size, x.size), complex)
     shared: dict[float, list[int]] = {}
     for i, src in enumerate(sources):
         if isinstance(src, PointSource) and not medium.is_free_space:
             src._check_air(medium)
             shared.setdefault(round(float(src.position[2]), 12), []).append(i)
         else:
-            out[i] = _unit(incident_on_planes(src, k, medium, x, y, zs))
+            for j, zj in enumerate(zs):
+                yield i, j, _unit(incident_on_plane(src, k, medium, x, y, float(zj)))
     if not shared:
-        return out
+        return
     X, Y = np.meshgrid(x, y)
     n = max(abs(medium.n(m)) for m in range(medium.n_regions))
     step = 2 * np.pi / (k * n) * _RADIAL_STEP_WAVELENGTHS
@@ -167,8 +207,7 @@ def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndar
                     pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, zj)], axis=1)
                     u *= _unit(s.pattern(ray_direction(k, medium, s.position, pts))
                                ).reshape(X.shape)
-                out[i, j] = u
-    return out
+                yield i, j, u
 
 
 def _unit(e: np.ndarray) -> np.ndarray:

@@ -22,8 +22,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["ViewerProcess", "find_chromium", "headless_chromium", "measure_slider",
-           "model_value", "set_model", "wait_idle"]
+__all__ = ["ViewerProcess", "click_button", "find_chromium", "headless_chromium", "measure_slider",
+           "model_value", "set_model", "shown_db", "wait_idle"]
 
 
 def find_chromium() -> tuple[str | None, str | None, str]:
@@ -139,12 +139,54 @@ def model_value(driver: Any, name: str, attr: str = "text") -> Any:
     return driver.execute_script(f"return {_MODEL}[arguments[1]];", name, attr)
 
 
-def set_model(driver: Any, name: str, attr: str, value: Any, *, settle: float = 0.0) -> None:
-    """Set a widget's property as a user's action would (it reaches the server), then wait
-    for the page to settle."""
-    driver.execute_script(f"{_MODEL}[arguments[1]] = arguments[2];", name, attr, value)
-    time.sleep(settle)
-    wait_idle(driver)
+_SET_JS = """
+const done = arguments[arguments.length - 1];
+const doc = Bokeh.documents[0];
+const model = doc.get_model_by_name(arguments[0]);
+const src = doc.get_model_by_name('image_source');
+if (JSON.stringify(model[arguments[1]]) === JSON.stringify(arguments[2])) { done(true); return; }
+const on = () => { src.change.disconnect(on); requestAnimationFrame(() => done(true)); };
+src.change.connect(on);
+model[arguments[1]] = arguments[2];
+setTimeout(() => { src.change.disconnect(on); done(false); }, arguments[3] * 1000);
+"""
+
+
+def set_model(driver: Any, name: str, attr: str, value: Any, *, timeout: float = 60.0) -> None:
+    """Set a widget's property as a user's action would (it reaches the server), and wait
+    until the picture it causes has arrived and been painted (at once when the property
+    already has that value: nothing changes).
+
+    Raises
+    ------
+    TimeoutError
+        No new picture within ``timeout`` seconds (the page's status says why).
+    """
+    driver.set_script_timeout(timeout + 5)
+    if not driver.execute_async_script(_SET_JS, name, attr, value, timeout):
+        status = model_value(driver, "status")
+        raise TimeoutError(f"no new picture after setting {name}.{attr} = {value!r}; "
+                           f"the page says: {status!r}")
+    wait_idle(driver, timeout)
+
+
+def shown_db(driver: Any) -> Any:
+    """The plan view's picture as the page holds it: |E| in dB re its reference, a
+    (ny, nx) array (rows along y, as the image is drawn)."""
+    import numpy as np
+
+    got = driver.execute_script(
+        "const d = Bokeh.documents[0].get_model_by_name('image_source').data;"
+        "return [Array.from(d.db[0]), d.db[0].shape];")
+    return np.asarray(got[0], dtype=float).reshape(got[1])
+
+
+def click_button(driver: Any, name: str) -> None:
+    """Press the page's button called ``name`` (as a click on it would)."""
+    driver.execute_script(
+        f"const m = {_MODEL};"
+        "const v = [...Bokeh.index.all_views()].find(v => v.model === m);"
+        "if (!v) throw new Error('no button ' + arguments[0]); v.click();", name)
 
 
 _LATENCY_JS = """

@@ -37,7 +37,7 @@ def _fmt_eps(e: complex | None, std: tuple[float, float] | None) -> str:
     if e is None:
         return "-"
     if std is None:
-        return f"{e.real:.3g}{e.imag:+.2g}j"
+        return f"{e.real:.3g}{e.imag:+.2g}j (no σ from this method)"
     return f"{e.real:.3g} ± {std[0]:.2g}, {e.imag:+.2g} ± {std[1]:.2g}j"
 
 
@@ -120,8 +120,10 @@ class ViewerPage:
             "layers from file" if "layer" in g else "half-space")
         self.ground_kind = Select(title="ground", options=opts, value=kind, name="ground",
                                   width=150)
-        eps = complex(str(g.get("eps", "2.5")).replace(" ", "").replace("i", "j")) \
-            if "layer" not in g else 2.5
+        # The spinners show the ground's eps at the views' frequency (a conductivity or a
+        # loss tangent given on the command line is in its imaginary part).
+        m = S.medium(s) if s.ground is not None and "layer" not in g else None
+        eps = complex(m.eps[1]) if m is not None and m.n_regions == 2 else 2.5 + 0j
         self.surface = Spinner(title="surface range (cm)", value=float(g.get("surface", 0.3)) * CM,
                                step=0.5, low=0.1, width=110, name="surface")
         self.eps_re = Spinner(title="eps'", value=eps.real, step=0.1, low=1.0, width=80,
@@ -406,14 +408,9 @@ class ViewerPage:
     def _plane(self) -> None:
         self.pending_plane = False
         self.s = self.s.replace(depth=float(self.depth.value) / CM)
-        # One message to the browser for the whole picture, not one per property.
-        self.doc.hold("combine")
-        try:
-            if self._guard(self._compute_plane):
-                if self.status.text.startswith('<span style="color:#b00">'):
-                    self.status.text = ""
-        finally:
-            self.doc.unhold()
+        if self._guard(self._compute_plane):
+            if self.status.text.startswith('<span style="color:#b00">'):
+                self.status.text = ""
 
     def _compute_plane(self) -> None:
         S, s = self.session, self.s
@@ -423,20 +420,22 @@ class ViewerPage:
         shown = scaled(amp, self.ref, s.scale, s.db_range).astype(np.float32)
         x0, w = _edges(img.x)
         y0, h = _edges(img.y)
-        self.src.data = {"image": [shown], "db": [db(amp, self.ref).astype(np.float32)],
-                         "x": [x0], "y": [y0], "dw": [w], "dh": [h]}
-        self.frames += 1
         surf = S.surface(s)
         pk = peak_of(img, self.ref)
         where = "depth" if s.ground is not None and s.plane != "mirror" else "range"
         at = float(img.z[0]) - (surf if where == "depth" else 0.0)
         pz = pk.z - (surf if where == "depth" else 0.0)
+        # The readouts go out before the picture: each change is its own message, and
+        # whoever waits for the picture (a user, a test) then finds them current.
         self.peak.text = (f"{where} {at * CM:.2f} cm\n"
                           f"peak: x = {pk.x * CM:.2f} cm, y = {pk.y * CM:.2f} cm, "
                           f"{where} = {pz * CM:.2f} cm, |E| = {pk.level_db:.1f} dB")
         for sp in self.depth_marks:
             sp.location = self.depth.value
         self._recolour_mapper()
+        self.src.data = {"image": [shown], "db": [db(amp, self.ref).astype(np.float32)],
+                         "x": [x0], "y": [y0], "dw": [w], "dh": [h]}
+        self.frames += 1
 
     def _recolour_mapper(self) -> None:
         s = self.s

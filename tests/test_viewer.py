@@ -1,0 +1,142 @@
+"""``holoradar view`` without a browser: its settings, its imaging, its exports and
+``holoradar render``. (The page itself is tested in Chromium by test_viewer_browser.)"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import holoradar as hr
+from holoradar.app.cli import main
+from holoradar.app.view.export import export_netcdf, export_png, export_settings
+from holoradar.app.view.server import is_loopback, make_server, url_of
+from holoradar.app.view.session import ViewSession
+from holoradar.app.view.settings import ViewSettings, read_settings, settings_toml
+
+SAND = {"surface": 0.30, "eps": "2.5+0.01j"}
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    """Two views of a point 12 cm deep in sand, from a horn at two places (simulated by
+    holoradar: these tests check the viewer's plumbing, the physics is tested elsewhere)."""
+    d = tmp_path_factory.mktemp("scene")
+    sand = hr.Medium.half_space(0.30, 2.5 + 0.01j)
+    target = [hr.PointTarget((0.02, -0.01, 0.42), 0.05)]
+    paths, views = [], []
+    for i, sx in enumerate((-0.15, 0.15)):
+        h = hr.simulate(hr.Scene(sand, hr.PointSource((sx, 0.0, -0.05)), target),
+                        hr.Aperture.grid(16, 0.025), 9.9e9)
+        views.append(h)
+        paths.append(hr.save(h, d / f"v{i}.nc"))
+    return paths, views, sand
+
+
+def test_settings_round_trip_through_toml(tmp_path):
+    s = ViewSettings(files=(str(tmp_path / "a.nc"), str(tmp_path / "b.nc")), depth=0.07,
+                     sweep=(0.0, 0.2), planes=21, views=(1,), mode="amplitude",
+                     frequency=3, glare="cut", direct=False, scale="linear", db_range=40.0,
+                     plane="mirror", section=(0.01, -0.02), ground=SAND)
+    p = tmp_path / "look.toml"
+    p.write_text(settings_toml(s, relative_to=tmp_path), encoding="utf-8")
+    assert '"a.nc"' in p.read_text()  # relative to the TOML's folder
+    assert read_settings(p) == s
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("[image]\ndepth = 'deep'\n", r"image.depth must be a depth in metres, got 'deep'"),
+    ("[glare]\nmethod = 'magic'\n", r"glare.method must be 'off' or 'gaussian'"),
+    ("[views]\nuse = []\n", r"views.use must be a non-empty list"),
+    ("[image]\nzoom = 2\n", r"unknown keys \['zoom'\] in \[image\]; expected depth"),
+    ("[camera]\n", r"unknown entries \['camera'\]"),
+    ("files = 'a.nc'\n", r"files must be a list of file names"),
+    ("depth = = 1\n", r"is not valid TOML"),
+])
+def test_bad_settings_name_the_key_and_the_expected_form(tmp_path, text, message):
+    p = tmp_path / "look.toml"
+    p.write_text(text, encoding="utf-8")
+    with pytest.raises(ValueError, match=message):
+        read_settings(p)
+
+
+def test_session_images_with_holoradars_functions(scene):
+    # The session is a view onto the library: the same call gives the same array.
+    paths, views, sand = scene
+    S = ViewSession(paths)
+    s = S.default_settings(ground=SAND).replace(depth=0.12)
+    both = S.image(s)
+    np.testing.assert_array_equal(
+        both.data, hr.synthesize(views, 0.42, medium=sand, upsample=4, fov="full").data)
+    one = S.image(s.replace(views=(1,)))
+    np.testing.assert_array_equal(
+        one.data, hr.migrate(views[1], 0.42, medium=sand, upsample=4, fov="full").data)
+    clean, notes = S.cleaned(s.replace(glare="gaussian"))
+    ref, rep = hr.suppress_surface(views[0], sand, method="gaussian")
+    np.testing.assert_array_equal(clean[0].data, ref.data)
+    assert notes[0].removed_db == rep.glare_removed_db
+
+
+def test_render_reproduces_an_exported_look(scene, tmp_path):
+    paths, _, _ = scene
+    S = ViewSession(paths)
+    s = S.default_settings(ground=SAND).replace(depth=0.12, glare="gaussian", views=(0,))
+    look = export_settings(s, tmp_path)
+    shown = export_netcdf(S, s, tmp_path)
+    png = export_png(S, s, tmp_path)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    out = tmp_path / "again.nc"
+    r = CliRunner().invoke(main, ["render", str(look), "-o", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    np.testing.assert_array_equal(hr.load(out).data, hr.load(shown).data)
+    assert json.loads(r.output)["depth_m"] == pytest.approx(0.12, abs=0.01)
+    assert out.with_suffix(".png").exists()
+    # never over an existing file unless asked; never over an input
+    again = CliRunner().invoke(main, ["render", str(look), "-o", str(out)])
+    assert again.exit_code != 0 and "--force" in again.output
+    onto = CliRunner().invoke(main, ["render", str(look), "-o", str(paths[0]), "--force"])
+    assert onto.exit_code != 0 and paths[0].exists()
+    assert hr.load(paths[0]).data.shape == (16, 16)
+
+
+def test_exports_never_replace_a_file(scene, tmp_path):
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    s = S.default_settings(ground=SAND)
+    first, second = export_png(S, s, tmp_path), export_png(S, s, tmp_path)
+    assert first != second and first.exists() and second.exists()
+    a, b = export_settings(s, tmp_path), export_settings(s, tmp_path)
+    assert a != b and read_settings(a) == read_settings(b)
+
+
+def test_view_refuses_a_file_it_cannot_read_with_the_clis_message(tmp_path):
+    bad = tmp_path / "notes.txt"
+    bad.write_text("not a hologram")
+    r = CliRunner().invoke(main, ["view", str(bad), "--no-browser"])
+    info = CliRunner().invoke(main, ["info", str(bad)])
+    assert r.exit_code != 0 and "unknown format '.txt'" in r.output
+    assert r.output.strip().splitlines()[-1] == info.output.strip().splitlines()[-1]
+    missing = CliRunner().invoke(main, ["view", str(tmp_path / "gone.nc"), "--no-browser"])
+    assert missing.exit_code != 0 and "does not exist" in missing.output
+
+
+def test_server_binds_the_loopback_and_warns_otherwise(scene):
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    s = S.default_settings(ground=SAND)
+    assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.5")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        server = make_server(S, s, export_dir=Path("."))
+    try:
+        assert url_of(server, "127.0.0.1").startswith("http://127.0.0.1:")
+    finally:
+        server.stop()
+    with pytest.warns(UserWarning, match="not the loopback"):
+        server = make_server(S, s, host="0.0.0.0", export_dir=Path("."))
+    server.stop()

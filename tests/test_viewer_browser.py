@@ -1,0 +1,244 @@
+"""``holoradar view`` end to end: the page in headless Chromium against the Python API.
+
+The page is driven as a user would (its widgets' values are set in the browser and
+reach the server over the websocket); what it shows is read from the models it
+draws (the peak readout, the glare report) and compared with the same settings
+computed by holoradar's public functions in this process.
+
+Data: gprMax's FDTD run C (independent full-wave data, tests/data/README.md): a
+steel rod 10 cm deep in sand, lit by a y-directed dipole 10 cm above the sand and
+20 cm to the side, with the sand's glare and the dipole's direct wave in the
+hologram; and SMUTHI's metal sphere in sand seen under five plane-wave incidences.
+
+Screenshots go to ``tmp_path``; with ``HOLORADAR_SCREENSHOTS=DIR`` (``make
+screenshots``) also to DIR, for the documentation's gallery.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from holoradar.analysis.metrics import peak_position
+from holoradar.app.view.browser import (
+    ViewerProcess,
+    click_button,
+    find_chromium,
+    headless_chromium,
+    measure_slider,
+    model_value,
+    set_model,
+    shown_db,
+    wait_idle,
+)
+
+DATA = Path(__file__).parent / "data"
+_, _, WHY = find_chromium()
+pytestmark = [pytest.mark.browser,
+              pytest.mark.skipif(bool(WHY), reason=f"no browser for the viewer tests: {WHY}")]
+
+SIGMA = 0.0069  # S/m, the sand of the gprMax runs
+PEAK = re.compile(r"peak: x = (-?[\d.]+) cm, y = (-?[\d.]+) cm, depth = (-?[\d.]+) cm, "
+                  r"\|E\| = (-?[\d.]+) dB")
+# The page prints cm with 2 decimals and dB with 1: a shown number is the API's
+# value rounded, so they agree to half the last digit (plus float noise).
+CM_TOL = 0.005 + 1e-9
+DB_TOL = 0.05 + 1e-9
+# The picture itself travels as float32 dB: 24-bit mantissa, so |dB| < 200 is carried to
+# 200 * 2**-24 = 1.2e-5 dB.
+PICTURE_DB_TOL = 2e-5
+
+
+def _db(img, ref: float) -> np.ndarray:
+    return 20 * np.log10(np.maximum(np.abs(img.data), 1e-300) / ref)
+
+
+def _shot(driver, tmp_path: Path, name: str) -> Path:
+    p = tmp_path / name
+    assert driver.save_screenshot(str(p)), "the browser took no screenshot"
+    assert p.stat().st_size > 10_000  # a page, not a blank
+    gallery = os.environ.get("HOLORADAR_SCREENSHOTS")
+    if gallery:
+        shutil.copyfile(p, Path(gallery) / name)
+    return p
+
+
+def _console_errors(driver) -> list[dict]:
+    return [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def _peak(driver) -> tuple[float, float, float, float]:
+    text = model_value(driver, "peak")
+    m = PEAK.search(text)
+    assert m, f"no peak readout in {text!r}"
+    x, y, d, level = map(float, m.groups())
+    return x / 100, y / 100, d / 100, level
+
+
+@pytest.fixture(scope="module")
+def rod(tmp_path_factory):
+    """Run C at 9.9 GHz as a holoradar file, with its dipole and sand."""
+    d = tmp_path_factory.mktemp("rod")
+    with np.load(DATA / "run_C_rod.npz") as c:
+        fi = int(np.argmin(np.abs(c["freqs_hz"] - 9.9e9)))
+        f = float(c["freqs_hz"][fi])
+        h = hr.Hologram(c["Ey"][fi].astype(complex), c["x_m"], c["y_m"], f,
+                        source=hr.PointSource((-0.20, 0.0, 0.20), axis=(0.0, 1.0, 0.0),
+                                              dipole=True))
+    sand = hr.Medium.half_space(0.30, hr.permittivity(2.5, sigma=SIGMA, frequency=f))
+    return hr.save(h, d / "rod.nc"), h, sand
+
+
+@pytest.fixture(scope="module")
+def browser():
+    driver = headless_chromium()
+    yield driver
+    driver.quit()
+
+
+@pytest.fixture(scope="module")
+def rod_page(rod, browser, tmp_path_factory):
+    path, _, _ = rod
+    out = tmp_path_factory.mktemp("exports")
+    with ViewerProcess([path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
+                        "--depth", "0.05", "--export-dir", out]) as server:
+        browser.get(server.url)
+        wait_idle(browser)
+        yield browser, server, out
+
+
+def _api_plane(h, sand, depth):
+    """What the page images at a depth: holoradar.migrate with the page's defaults
+    (4x upsampling, the full field of view), in dB re the depth sweep's peak."""
+    img = hr.migrate(h, 0.30 + depth, medium=sand, upsample=4, fov="full")
+    sweep = hr.migrate(h, 0.30 + np.linspace(0.0, 0.25, 61), medium=sand, upsample=4,
+                       fov="full")
+    return img, _db(img, np.abs(sweep.data).max())
+
+
+def test_depth_slider_shows_the_apis_peak(rod, rod_page, tmp_path):
+    _, h, sand = rod
+    driver, _, _ = rod_page
+    for depth_cm in (10.0, 7.5):
+        set_model(driver, "depth", "value", depth_cm)
+        x, y, d, level = _peak(driver)
+        img, api_db = _api_plane(h, sand, depth_cm / 100)
+        ax, ay, az = peak_position(img)
+        assert abs(x - ax) < CM_TOL / 100 and abs(y - ay) < CM_TOL / 100
+        assert abs(d - (az - 0.30)) < CM_TOL / 100
+        assert abs(level - api_db.max()) < DB_TOL
+        np.testing.assert_allclose(shown_db(driver), api_db, rtol=0, atol=PICTURE_DB_TOL)
+    _shot(driver, tmp_path, "viewer_rod_raw.png")
+    assert not _console_errors(driver)
+
+
+def test_glare_suppression_reports_the_apis_numbers(rod, rod_page, tmp_path):
+    _, h, sand = rod
+    driver, _, _ = rod_page
+    set_model(driver, "depth", "value", 10.0)
+    set_model(driver, "glare", "value", "image_source")
+    report = model_value(driver, "glare_report")
+    cleaned, rep = hr.suppress_surface(h, sand, h.source, "image_source")
+    cells = re.findall(r"<td>([^<]*)</td>", report)
+    assert cells[0] == "rod.nc", report
+    assert abs(float(cells[1]) - rep.glare_removed_db) < DB_TOL
+    assert abs(float(cells[2]) - rep.glare_suppression_db) < DB_TOL
+    # eps shown as "re ± std, im ± std j" with 3 significant digits
+    m = re.match(r"([\d.]+) ± ([\d.e-]+), ([+-][\d.e-]+) ± ([\d.e-]+)j", cells[3])
+    assert m, cells[3]
+    assert float(m.group(1)) == pytest.approx(rep.eps.real, rel=5e-3)
+    # The image after suppression: the rod, where the API's cleaned hologram puts it.
+    x, y, d, _ = _peak(driver)
+    img = hr.migrate(cleaned, 0.40, medium=sand, upsample=4, fov="full")
+    ax, ay, _ = peak_position(img)
+    assert abs(x - ax) < CM_TOL / 100 and abs(y - ay) < CM_TOL / 100
+    assert abs(d - 0.10) < CM_TOL / 100
+    _shot(driver, tmp_path, "viewer_rod_glare.png")
+    assert not _console_errors(driver)
+    set_model(driver, "glare", "value", "off")
+
+
+def test_exports_reproduce_the_look_in_batch(rod, rod_page, tmp_path):
+    driver, _, out = rod_page
+    set_model(driver, "depth", "value", 10.0)
+    before = set(out.iterdir())
+    for what in ("png", "netcdf", "settings"):
+        click_button(driver, f"export_{what}")
+    t0 = time.monotonic()
+    while len(set(out.iterdir()) - before) < 3 and time.monotonic() - t0 < 30:
+        time.sleep(0.05)
+    new = sorted(set(out.iterdir()) - before)
+    assert sorted(p.suffix for p in new) == [".nc", ".png", ".toml"]
+    toml = next(p for p in new if p.suffix == ".toml")
+    shown = hr.load(next(p for p in new if p.suffix == ".nc"))
+    from click.testing import CliRunner
+
+    from holoradar.app.cli import main
+
+    res = CliRunner().invoke(main, ["render", str(toml), "-o", str(tmp_path / "again.nc")])
+    assert res.exit_code == 0, res.output
+    again = hr.load(tmp_path / "again.nc")
+    np.testing.assert_array_equal(again.data, shown.data)
+
+
+def test_latency_of_the_slider_is_measured(rod_page):
+    # Only that the measurement works (a number per move); its speed is the benchmark's.
+    driver, _, _ = rod_page
+    ms = measure_slider(driver, [6.0, 6.5])
+    assert len(ms) == 2 and all(m > 0 for m in ms)
+
+
+@pytest.fixture(scope="module")
+def sphere_files(tmp_path_factory):
+    """SMUTHI's five views of the sphere, each with its plane wave (phase 0 at the
+    aperture's centre: the fixture's phase reference is the sand surface, 0.30 m below)."""
+    d = tmp_path_factory.mktemp("sphere")
+    paths, views = [], []
+    for inc in ("+00", "+20", "-20", "+40", "-40"):
+        with np.load(DATA / f"S2_buried_sphere_metal_inc{inc}.npz") as z:
+            f = float(z["f_hz"][0])
+            th = np.radians(float(inc))
+            ref = np.exp(1j * 2 * np.pi * f / hr.C0 * np.cos(th) * 0.30)
+            h = hr.Hologram(z["E_scat"][1] * ref, z["x_m"], z["y_m"], f,
+                            source=hr.PlaneWave(th, 0.0))
+            eps = complex(z["sand_eps"][0])
+        views.append(h)
+        paths.append(hr.save(h, d / f"sphere{inc}.nc"))
+    return paths, views, hr.Medium.half_space(0.30, eps), eps
+
+
+def test_views_and_synthesis_mode_match_synthesize(sphere_files, browser, tmp_path):
+    paths, views, sand, eps = sphere_files
+    # A look saved as the page's settings export writes it: 2x upsampling and 21 planes
+    # keep the five 64 x 64 views quick; the sand as a ground table.
+    look = paths[0].parent / "look.toml"
+    look.write_text(
+        f'files = [{", ".join(repr(p.name) for p in paths)}]\n'
+        "[image]\ndepth = 0.09\nupsample = 2\nplanes = 21\nsweep = [0.0, 0.2]\n"
+        f'[ground]\nsurface = 0.30\neps = "{eps.real}{eps.imag:+}j"\n', encoding="utf-8")
+    with ViewerProcess(["--settings", look]) as server:
+        browser.get(server.url)
+        wait_idle(browser)
+        for use, mode in (([0, 1, 2, 3, 4], "coherent"), ([0, 3, 4], "coherent"),
+                          ([0, 3, 4], "amplitude")):
+            set_model(browser, "views", "active", use)
+            set_model(browser, "mode", "value", mode)
+            x, y, d, _ = _peak(browser)
+            chosen = [views[i] for i in use]
+            img = hr.synthesize(chosen, 0.39, medium=sand, mode=mode, upsample=2, fov="full")
+            sweep = hr.synthesize(chosen, 0.30 + np.linspace(0.0, 0.2, 21), medium=sand,
+                                  mode=mode, upsample=2, fov="full")
+            ax, ay, az = peak_position(img)
+            assert abs(x - ax) < CM_TOL / 100 and abs(y - ay) < CM_TOL / 100, (use, mode)
+            assert abs(d - (az - 0.30)) < CM_TOL / 100
+            np.testing.assert_allclose(shown_db(browser), _db(img, np.abs(sweep.data).max()),
+                                       rtol=0, atol=PICTURE_DB_TOL, err_msg=f"{use} {mode}")
+        _shot(browser, tmp_path, "viewer_sphere_views.png")
+        assert not _console_errors(browser)
