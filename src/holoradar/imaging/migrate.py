@@ -9,21 +9,19 @@ paraxial Eq. 3 (through a medium: at the apparent distance).
 
 from __future__ import annotations
 
-import os
 import warnings
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
-from functools import cache
 from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
 from tqdm.auto import tqdm
 
+from .._threads import POOL_SIZE, pool
 from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
 from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
-from ..physics.incident import incident_on_planes
+from ..physics.incident import incident_phasors
 from ..physics.medium import Medium
 from ..physics.propagation import (
     DEFAULT_SNR_DB,
@@ -38,7 +36,6 @@ from . import kspace, oblique
 __all__ = ["IlluminationWarning", "migrate"]
 
 _CHUNK = 8  # planes per batched inverse FFT
-_POOL_SIZE = os.cpu_count() or 1
 
 
 def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
@@ -434,7 +431,7 @@ def _incident_phasor(source: Any, k: float, medium: Medium, img: Image,
         pts = (pose.to_world(X, Y)[None] + img.z[:, None, None, None] * pose.normal)
         e0 = src.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
     else:
-        e0 = incident_on_planes(src, k, medium, img.x, img.y, img.z)
+        return incident_phasors([src], k, medium, img.x, img.y, img.z)[0]
     mag = np.abs(e0)
     return np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
 
@@ -466,7 +463,7 @@ def _multiply_planes(H: np.ndarray, Ucs: list[np.ndarray], prod: np.ndarray) -> 
     """
     rows = H.shape[-2]
     # Tasks: (plane, row block); a single plane is split in row blocks across cores.
-    blocks = max(1, -(-_POOL_SIZE // len(Ucs))) if rows >= 64 else 1
+    blocks = max(1, -(-POOL_SIZE // len(Ucs))) if rows >= 64 else 1
     edges = np.linspace(0, rows, blocks + 1).astype(int)
     tasks = [(i, slice(edges[b], edges[b + 1])) for i in range(len(Ucs)) for b in range(blocks)]
 
@@ -474,16 +471,11 @@ def _multiply_planes(H: np.ndarray, Ucs: list[np.ndarray], prod: np.ndarray) -> 
         i, r = task
         np.multiply(H[..., r, :], Ucs[i][r, :], out=prod[..., i, r, :])
 
-    if len(tasks) < 2 or _POOL_SIZE < 2:
+    if len(tasks) < 2 or POOL_SIZE < 2:
         for t in tasks:
             work(t)
         return
-    list(_pool().map(work, tasks))
-
-
-@cache
-def _pool() -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=_POOL_SIZE, thread_name_prefix="holoradar")
+    list(pool().map(work, tasks))
 
 
 def _zero_pad_spectrum(S: np.ndarray, u: int) -> np.ndarray:

@@ -11,7 +11,8 @@ A Gaussian beam is summed directly.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -140,8 +141,9 @@ def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndar
     """
     zs = np.atleast_1d(np.asarray(z, dtype=float))
     out = np.empty((len(sources), zs.size, np.size(y), np.size(x)), complex)
-    for i, j, u in _phasor_planes(sources, k, medium, x, y, zs):
-        out[i, j] = u
+    for i, plane in enumerate(_phasor_makers(sources, k, medium, x, y, zs)):
+        for j in range(zs.size):
+            out[i, j] = plane(j)
     return out
 
 
@@ -150,8 +152,8 @@ def remove_incident_phase(images: np.ndarray, sources: list[object], k: float,
     """Multiply ``images[i, j]`` (len(sources), len(z), y.size, x.size) in place by
     source i's unit phasor ``conj(E0)/|E0|`` on the plane at range ``z[j]``.
 
-    The same phasors as :func:`incident_phasors`, made one plane at a time: a depth
-    sweep of many views never holds them all.
+    The same phasors as :func:`incident_phasors`, made one plane at a time (a depth
+    sweep of many views never holds them all).
 
     Examples
     --------
@@ -169,45 +171,85 @@ def remove_incident_phase(images: np.ndarray, sources: list[object], k: float,
     if images.shape != want:
         raise ValueError(f"images must have shape (sources, planes, y, x) = {want}, got "
                          f"{images.shape}")
-    for i, j, u in _phasor_planes(sources, k, medium, x, y, zs):
-        images[i, j] *= u
+    for i, plane in enumerate(_phasor_makers(sources, k, medium, x, y, zs)):
+        for j in range(zs.size):
+            images[i, j] *= plane(j)
 
 
-def _phasor_planes(sources: list[object], k: float, medium: Medium, x: np.ndarray,
-                   y: np.ndarray, zs: np.ndarray) -> Iterator[tuple[int, int, np.ndarray]]:
-    """``(source index, plane index, unit phasor (y.size, x.size))`` for every pair."""
+def _phasor_makers(sources: list[object], k: float, medium: Medium, x: np.ndarray,
+                   y: np.ndarray, zs: np.ndarray) -> list[Callable[[int], np.ndarray]]:
+    """For each source, a function of the plane index giving its unit phasor there
+    (y.size, x.size); what the sources share is computed here, once."""
     x, y = np.asarray(x, float), np.asarray(y, float)
+    makers: list[Callable[[int], np.ndarray] | None] = [None] * len(sources)
     shared: dict[float, list[int]] = {}
     for i, src in enumerate(sources):
         if isinstance(src, PointSource) and not medium.is_free_space:
             src._check_air(medium)
             shared.setdefault(round(float(src.position[2]), 12), []).append(i)
         else:
-            for j, zj in enumerate(zs):
-                yield i, j, _unit(incident_on_plane(src, k, medium, x, y, float(zj)))
-    if not shared:
-        return
-    X, Y = np.meshgrid(x, y)
-    n = max(abs(medium.n(m)) for m in range(medium.n_regions))
-    step = 2 * np.pi / (k * n) * _RADIAL_STEP_WAVELENGTHS
-    for members in shared.values():
-        srcs = [sources[i] for i in members]
-        rhos = [np.hypot(X - s.position[0], Y - s.position[1]) for s in srcs]
-        r = np.arange(0.0, max(float(p.max()) for p in rhos) + 2 * step, step)
-        prof = transmitted_profiles(k, medium, float(srcs[0].position[2]), zs, r)
-        phase = np.unwrap(np.angle(prof), axis=-1)
-        vanishes = not np.all(np.abs(prof) > 0)
-        for i, s, rho in zip(members, srcs, rhos, strict=True):
-            for j, zj in enumerate(zs):
-                # Only the phase is needed: one interpolation instead of two.
-                u = np.exp(-1j * np.interp(rho, r, phase[j]))
-                if vanishes:
-                    u[np.interp(rho, r, np.abs(prof[j])) == 0] = 0
-                if s.has_pattern:
-                    pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, zj)], axis=1)
-                    u *= _unit(s.pattern(ray_direction(k, medium, s.position, pts))
-                               ).reshape(X.shape)
-                yield i, j, u
+            makers[i] = functools.partial(_direct_phasor, src, k, medium, x, y, zs)
+    if shared:
+        X, Y = np.meshgrid(x, y)
+        n = max(abs(medium.n(m)) for m in range(medium.n_regions))
+        step = 2 * np.pi / (k * n) * _RADIAL_STEP_WAVELENGTHS
+        for members in shared.values():
+            srcs = [sources[i] for i in members]
+            rhos = [np.hypot(X - s.position[0], Y - s.position[1]) for s in srcs]
+            r = np.arange(0.0, max(float(p.max()) for p in rhos) + 2 * step, step)
+            prof = transmitted_profiles(k, medium, float(srcs[0].position[2]), zs, r)
+            phase = np.unwrap(np.angle(prof), axis=-1)
+            amp = np.abs(prof) if not np.all(np.abs(prof) > 0) else None
+            # Snell's law along the radial grid: the take-off angle depends only on rho
+            # and on the heights, so it is the same for every source of the group.
+            sin_line = ([_take_off_sines(k, medium, srcs[0].position, float(zj), r)
+                         for zj in zs] if any(s.has_pattern for s in srcs) else [])
+            for i, s, rho in zip(members, srcs, rhos, strict=True):
+                makers[i] = functools.partial(_radial_phasor, s, zs, r, phase, amp, sin_line,
+                                              rho, X, Y)
+    return makers  # type: ignore[return-value]
+
+
+def _direct_phasor(source: object, k: float, medium: Medium, x: np.ndarray, y: np.ndarray,
+                   zs: np.ndarray, j: int) -> np.ndarray:
+    return _unit(incident_on_plane(source, k, medium, x, y, float(zs[j])))
+
+
+def _radial_phasor(source: PointSource, zs: np.ndarray, r: np.ndarray, phase: np.ndarray,
+                   amp: np.ndarray | None, sin_line: list[np.ndarray], rho: np.ndarray,
+                   X: np.ndarray, Y: np.ndarray, j: int) -> np.ndarray:
+    # Only the phase is needed: one interpolation instead of two.
+    u = np.exp(-1j * np.interp(rho, r, phase[j]))
+    if amp is not None:  # the field vanishes somewhere on the radial grid
+        u[np.interp(rho, r, amp[j]) == 0] = 0
+    if source.has_pattern:
+        dirs = _radial_directions(source, float(zs[j]), r, sin_line[j], rho, X, Y)
+        u *= _unit(source.pattern(dirs)).reshape(X.shape)
+    return u
+
+
+def _take_off_sines(k: float, medium: Medium, src: np.ndarray, z: float,
+                    r: np.ndarray) -> np.ndarray:
+    """Sine of the angle, in the air, at which the refracted ray leaves ``src`` for a
+    point at lateral distance ``r`` and range ``z`` (Snell's law, as ray_direction)."""
+    line = np.stack([src[0] + r, np.full(r.size, src[1]), np.full(r.size, z)], axis=1)
+    return ray_direction(k, medium, src, line)[:, 0]
+
+
+def _radial_directions(source: PointSource, z: float, r: np.ndarray, sin_line: np.ndarray,
+                       rho: np.ndarray, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """Directions (N, 3) in which the refracted rays leave ``source`` for the pixels
+    ``(X, Y, z)``: the take-off sines along the radial grid ``r`` interpolated at each
+    pixel's lateral distance ``rho``, with the pixel's own azimuth. A pattern's phase (its
+    sign, for the real patterns) is all the phasor needs: exact except next to the
+    pattern's zeros."""
+    src = source.position
+    sin_t = np.interp(rho, r, sin_line)
+    # cos and sin of the azimuth are (X - x_s)/rho and (Y - y_s)/rho (0 under the source).
+    s_rho = np.divide(sin_t, rho, out=np.zeros_like(rho), where=rho > 0)
+    cz = np.sqrt(np.clip(1 - sin_t**2, 0, None)) * (1.0 if z >= src[2] else -1.0)
+    return np.stack([(s_rho * (X - src[0])).ravel(), (s_rho * (Y - src[1])).ravel(),
+                     cz.ravel()], axis=1)
 
 
 def _unit(e: np.ndarray) -> np.ndarray:

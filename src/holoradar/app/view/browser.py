@@ -197,22 +197,37 @@ const slider = doc.get_model_by_name('depth');
 const t0 = performance.now();
 const on = () => {
   src.change.disconnect(on);
-  requestAnimationFrame(() => requestAnimationFrame(() => done(performance.now() - t0)));
+  const arrived = performance.now() - t0;
+  // BokehJS paints in the next animation frame; this callback runs after its paint,
+  // and the one after that once the frame has been shown.
+  requestAnimationFrame(() => {
+    const painted = performance.now() - t0;
+    requestAnimationFrame(() => done([arrived, painted, performance.now() - t0]));
+  });
 };
 src.change.connect(on);
 slider.value = arguments[0];
-setTimeout(() => { src.change.disconnect(on); done(-1); }, 20000);
+setTimeout(() => { src.change.disconnect(on); done(null); }, 20000);
 """
 
 
-def measure_slider(driver: Any, depths_cm: Sequence[float]) -> list[float]:
-    """Milliseconds from each depth-slider move to the new picture painted in the browser
-    (the image's data arrived and two animation frames passed)."""
+def measure_slider(driver: Any, depths_cm: Sequence[float]) -> Any:
+    """Milliseconds from each depth-slider move to the new picture in the browser.
+
+    Returns
+    -------
+    ndarray, shape (len(depths_cm), 3)
+        Per move: the new picture's data has arrived; it has been painted (the
+        animation frame after its arrival); that frame has been shown (the next
+        one). The last is the time a user waits.
+    """
+    import numpy as np
+
     driver.set_script_timeout(30)
     out = []
     for d in depths_cm:
         ms = driver.execute_async_script(_LATENCY_JS, float(d))
-        if ms < 0:
+        if ms is None:
             raise TimeoutError(f"no new picture after moving the slider to {d} cm")
-        out.append(float(ms))
-    return out
+        out.append([float(v) for v in ms])
+    return np.array(out)

@@ -191,16 +191,17 @@ class ViewerPage:
             buttons.append(bt)
         # figures
         self.mapper = LinearColorMapper(palette="Inferno256", low=-s.db_range, high=0.0)
-        self.src = ColumnDataSource(data={"image": [np.zeros((2, 2), np.float32)],
-                                          "db": [np.zeros((2, 2), np.float32)],
+        # dB is drawn straight from the readout's "db" column (the mapper floors it at
+        # -db_range): one array per picture over the websocket; linear adds "lin".
+        self.src = ColumnDataSource(data={"db": [np.zeros((2, 2), np.float32)],
                                           "x": [0.0], "y": [0.0], "dw": [1.0], "dh": [1.0]},
                                     name="image_source")
         tools = "pan,wheel_zoom,box_zoom,reset,save,tap"
         self.fig = figure(title="plan view", width=520, height=480, tools=tools,
                           match_aspect=True, x_axis_label="x (cm)", y_axis_label="y (cm)",
                           name="plan")
-        self.fig.image(image="image", x="x", y="y", dw="dw", dh="dh", source=self.src,
-                       color_mapper=self.mapper)
+        self.plan = self.fig.image(image="db", x="x", y="y", dw="dw", dh="dh",
+                                   source=self.src, color_mapper=self.mapper)
         self.bar = ColorBar(color_mapper=self.mapper, title="|E| (dB re sweep peak)",
                             width=12)
         self.fig.add_layout(self.bar, "right")
@@ -417,7 +418,6 @@ class ViewerPage:
         img = S.image(s)
         self.plane = img
         amp = np.abs(img.data)
-        shown = scaled(amp, self.ref, s.scale, s.db_range).astype(np.float32)
         x0, w = _edges(img.x)
         y0, h = _edges(img.y)
         surf = S.surface(s)
@@ -433,8 +433,15 @@ class ViewerPage:
         for sp in self.depth_marks:
             sp.location = self.depth.value
         self._recolour_mapper()
-        self.src.data = {"image": [shown], "db": [db(amp, self.ref).astype(np.float32)],
-                         "x": [x0], "y": [y0], "dw": [w], "dh": [h]}
+        data = {"db": [db(amp, self.ref).astype(np.float32)], "x": [x0], "y": [y0],
+                "dw": [w], "dh": [h]}
+        if s.scale == "linear":
+            data["lin"] = [scaled(amp, self.ref, "linear", s.db_range).astype(np.float32)]
+        else:
+            self.plan.glyph.image = "db"  # before the data that may lack "lin"
+        self.src.data = data
+        if s.scale == "linear":
+            self.plan.glyph.image = "lin"  # after the data that has it
         self.frames += 1
 
     def _recolour_mapper(self) -> None:
