@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint bench clean browser
+.PHONY: demo test test-slow lint bench clean browser screenshots
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -37,6 +37,11 @@ test: $(STAMP) browser
 
 test-slow: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m slow
+
+# The documentation's pictures of the viewer, taken by its browser tests.
+screenshots: $(STAMP) browser
+	HOLORADAR_SCREENSHOTS=docs/figures MPLBACKEND=Agg $(BIN)/python -m pytest -q \
+	  tests/test_viewer_browser.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples

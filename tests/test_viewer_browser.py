@@ -45,7 +45,7 @@ pytestmark = [pytest.mark.browser,
               pytest.mark.skipif(bool(WHY), reason=f"no browser for the viewer tests: {WHY}")]
 
 SIGMA = 0.0069  # S/m, the sand of the gprMax runs
-PEAK = re.compile(r"peak: x = (-?[\d.]+) cm, y = (-?[\d.]+) cm, depth = (-?[\d.]+) cm, "
+PEAK = re.compile(r"peak: x = (-?[\d.]+) cm, y = (-?[\d.]+) cm,\s+depth = (-?[\d.]+) cm, "
                   r"\|E\| = (-?[\d.]+) dB")
 # The page prints cm with 2 decimals and dB with 1: a shown number is the API's
 # value rounded, so they agree to half the last digit (plus float noise).
@@ -98,7 +98,7 @@ def rod(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def browser():
-    driver = headless_chromium()
+    driver = headless_chromium(1600, 1150)  # the whole page, for the screenshots
     yield driver
     driver.quit()
 

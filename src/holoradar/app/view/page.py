@@ -33,6 +33,11 @@ def _edges(c: np.ndarray, unit: float = CM) -> tuple[float, float]:
     return float((c[0] - step / 2) * unit), float(step * c.size * unit)
 
 
+def _cm(v: float, digits: int = 2) -> str:
+    """``v`` metres in cm, rounded, never "-0.00"."""
+    return f"{round(v * CM, digits) + 0.0:.{digits}f}"
+
+
 def _fmt_eps(e: complex | None, std: tuple[float, float] | None) -> str:
     if e is None:
         return "-"
@@ -245,9 +250,9 @@ class ViewerPage:
         self.h_spec = ColumnDataSource(data=dict(self.xz_src.data))
         self.hfigs = []
         for title, src, pal, lab in (
-                ("amplitude |E|", self.h_amp, "Viridis256", ("x (cm)", "y (cm)")),
+                ("|E|", self.h_amp, "Viridis256", ("x (cm)", "y (cm)")),
                 ("phase (rad)", self.h_phase, "Turbo256", ("x (cm)", "y (cm)")),
-                ("spectral window |FFT| (dB)", self.h_spec, "Magma256",
+                ("spectral window (dB)", self.h_spec, "Magma256",
                  ("kx / k", "ky / k"))):
             f = figure(title=title, width=280, height=260, tools="pan,wheel_zoom,reset,save",
                        match_aspect=True, x_axis_label=lab[0], y_axis_label=lab[1])
@@ -256,10 +261,9 @@ class ViewerPage:
             f.add_layout(ColorBar(color_mapper=m, width=8), "right")
             self.hfigs.append(f)
         t = np.linspace(0, 2 * np.pi, 181)
-        self.hfigs[2].line(np.cos(t), np.sin(t), color="white", line_dash="dashed",
-                           legend_label="|k_t| = k")
-        self.hfigs[2].legend.location = "top_left"
-        self.hfigs[2].legend.background_fill_alpha = 0.3
+        self.hfigs[2].line(np.cos(t), np.sin(t), color="white", line_dash="dashed")
+        self.hfigs[2].add_layout(Label(x=0.55, y=0.8, text="|k_t| = k", text_color="white",
+                                       text_font_size="9pt"))
         # the cursor readout: x, y from the pointer, the value from the shown plane
         self.fig.js_on_event("mousemove", CustomJS(args={"src": self.src, "div": self.readout,
                                                          "depth": self.depth}, code="""
@@ -427,9 +431,9 @@ class ViewerPage:
         pz = pk.z - (surf if where == "depth" else 0.0)
         # The readouts go out before the picture: each change is its own message, and
         # whoever waits for the picture (a user, a test) then finds them current.
-        self.peak.text = (f"{where} {at * CM:.2f} cm\n"
-                          f"peak: x = {pk.x * CM:.2f} cm, y = {pk.y * CM:.2f} cm, "
-                          f"{where} = {pz * CM:.2f} cm, |E| = {pk.level_db:.1f} dB")
+        self.peak.text = (f"{where} {_cm(at)} cm\n"
+                          f"peak: x = {_cm(pk.x)} cm, y = {_cm(pk.y)} cm,\n"
+                          f"{where} = {_cm(pz)} cm, |E| = {pk.level_db:.1f} dB")
         for sp in self.depth_marks:
             sp.location = self.depth.value
         self._recolour_mapper()
@@ -481,8 +485,8 @@ class ViewerPage:
             c0, w = _edges(c)
             src.data = {"image": [scaled(a, self.ref, s.scale, s.db_range).astype(np.float32)],
                         "x": [c0], "y": [z0], "dw": [w], "dh": [dz]}
-        self.xz.title.text = f"x-z section at y = {y * CM:.1f} cm"
-        self.yz.title.text = f"y-z section at x = {x * CM:.1f} cm"
+        self.xz.title.text = f"x-z section at y = {_cm(y, 1)} cm"
+        self.yz.title.text = f"y-z section at x = {_cm(x, 1)} cm"
         self.vline.location, self.hline.location = x * CM, y * CM
 
     def _holo(self) -> None:
@@ -503,8 +507,8 @@ class ViewerPage:
         kx0, kw = _edges(kx, 1.0)
         ky0, kh = _edges(ky, 1.0)
         self.h_spec.data = {"image": [sdb], "x": [kx0], "y": [ky0], "dw": [kw], "dh": [kh]}
-        state = "after glare suppression" if s.glare != "off" else "as recorded"
-        self.hfigs[0].title.text = f"amplitude |E|, {state}"
+        state = "glare removed" if s.glare != "off" else "as recorded"
+        self.hfigs[0].title.text = f"|E|, {state}"
 
     def _glare(self) -> None:
         S, s = self.session, self.s
