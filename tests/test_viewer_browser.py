@@ -242,3 +242,25 @@ def test_views_and_synthesis_mode_match_synthesize(sphere_files, browser, tmp_pa
                                        rtol=0, atol=PICTURE_DB_TOL, err_msg=f"{use} {mode}")
         _shot(browser, tmp_path, "viewer_sphere_views.png")
         assert not _console_errors(browser)
+
+
+def test_an_image_volume_shows_its_own_planes(rod, browser, tmp_path):
+    # An image file: no imaging in the page, its planes and its colour scale (dB re the
+    # volume's brightest voxel).
+    _, h, sand = rod
+    vol = hr.migrate(h, np.linspace(0.35, 0.45, 11), medium=sand, upsample=2)
+    path = hr.save(vol, tmp_path / "rod_volume.nc")
+    with ViewerProcess([path]) as server:
+        browser.get(server.url)
+        wait_idle(browser)
+        set_model(browser, "depth", "value", 40.0)  # range from the array, cm
+        plane = vol.plane(0.40)
+        np.testing.assert_allclose(shown_db(browser), _db(plane, np.abs(vol.data).max()),
+                                   rtol=0, atol=PICTURE_DB_TOL)
+        m = re.search(r"peak: x = (-?[\d.]+) cm, y = (-?[\d.]+) cm,\s+range = (-?[\d.]+) cm",
+                      model_value(browser, "peak"))
+        ax, ay, az = peak_position(plane)
+        assert m and abs(float(m[1]) / 100 - ax) < CM_TOL / 100
+        assert abs(float(m[2]) / 100 - ay) < CM_TOL / 100
+        assert abs(float(m[3]) / 100 - az) < CM_TOL / 100
+        assert not _console_errors(browser)

@@ -111,9 +111,11 @@ class ViewerPage:
         self.depth = Slider(title=label, start=a * CM, end=b * CM, step=step * CM,
                             value=min(max(s.depth, a), b) * CM, name="depth", width=320)
         self.depth.on_change("value", lambda _a, _o, _n: self._schedule_plane())
-        self.sweep_a = Spinner(title="sweep from (cm)", value=a * CM, step=0.5, width=100,
+        self.sweep_a = Spinner(title="sweep from (cm)", value=round(a * CM, 3), step=0.5,
+                               width=100, format="0[.]00",
                                name="sweep_a")
-        self.sweep_b = Spinner(title="to (cm)", value=b * CM, step=0.5, width=100,
+        self.sweep_b = Spinner(title="to (cm)", value=round(b * CM, 3), step=0.5, width=100,
+                               format="0[.]00",
                                name="sweep_b")
         for w in (self.sweep_a, self.sweep_b):
             w.on_change("value", lambda _a, _o, _n: self._set_sweep())
@@ -134,6 +136,7 @@ class ViewerPage:
         self.eps_re = Spinner(title="eps'", value=eps.real, step=0.1, low=1.0, width=80,
                               name="eps_re")
         self.eps_im = Spinner(title="eps''", value=eps.imag, step=0.01, low=0.0, width=80,
+                              format="0[.]0000",
                               name="eps_im")
         for w in (self.ground_kind, self.surface, self.eps_re, self.eps_im):
             w.on_change("value", lambda _a, _o, _n: self._set_ground())
@@ -286,9 +289,13 @@ class ViewerPage:
             row(self.scale, self.db_range), self.click, clear, row(*buttons[:2]),
             buttons[2], self.exported, width=340)
         readouts = column(self.readout, self.ruler)
-        holo_row = row(column(self.holo_view, self.hfigs[0]), self.hfigs[1], self.hfigs[2])
-        layout = row(controls, column(row(column(self.fig, readouts),
-                                          column(self.xz, self.yz)), holo_row))
+        # The hologram row only where holograms were opened (an image has none).
+        holo_row = row(column(self.holo_view, self.hfigs[0]), self.hfigs[1], self.hfigs[2],
+                       visible=holo)
+        # A survey's mosaic is one plane at a time: no sections.
+        plots = [column(self.fig, readouts)] + ([column(self.xz, self.yz)]
+                                                if S.kind != "survey" else [])
+        layout = row(controls, column(row(*plots), holo_row))
         if not holo:
             for w in (self.ground_kind, self.surface, self.eps_re, self.eps_im, self.glare,
                       self.direct, self.which, self.mode, self.freq, self.frame,
@@ -466,11 +473,7 @@ class ViewerPage:
         S, s, vol = self.session, self.s, self.volume
         if vol is None:
             return
-        if S.kind == "survey":
-            for src in (self.xz_src, self.yz_src):
-                src.data = {"image": [np.zeros((2, 2), np.float32)], "x": [0.0], "y": [0.0],
-                            "dw": [1.0], "dh": [1.0]}
-            self.xz.title.text = self.yz.title.text = "sections: not for a survey mosaic"
+        if S.kind == "survey":  # not in the page (see _build)
             return
         if s.section is not None:
             x, y = s.section
