@@ -16,6 +16,7 @@ screenshots``) also to DIR, for the documentation's gallery.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
@@ -70,6 +71,21 @@ def _shot(driver, tmp_path: Path, name: str) -> Path:
     return p
 
 
+@contextlib.contextmanager
+def _page(browser, args):
+    """``holoradar view ARGS`` served and open in the browser. On leaving, the browser
+    leaves the page before the server stops: the closed websocket is not the next
+    page's console error."""
+    with ViewerProcess(args) as server:
+        browser.get(server.url)
+        wait_idle(browser)
+        try:
+            yield server
+        finally:
+            browser.get("about:blank")
+            browser.get_log("browser")
+
+
 def _console_errors(driver) -> list[dict]:
     return [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
 
@@ -107,10 +123,8 @@ def browser():
 def rod_page(rod, browser, tmp_path_factory):
     path, _, _ = rod
     out = tmp_path_factory.mktemp("exports")
-    with ViewerProcess([path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
-                        "--depth", "0.05", "--export-dir", out]) as server:
-        browser.get(server.url)
-        wait_idle(browser)
+    with _page(browser, [path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
+                         "--depth", "0.05", "--export-dir", out]) as server:
         yield browser, server, out
 
 
@@ -223,9 +237,7 @@ def test_views_and_synthesis_mode_match_synthesize(sphere_files, browser, tmp_pa
         f'files = [{", ".join(repr(p.name) for p in paths)}]\n'
         "[image]\ndepth = 0.09\nupsample = 2\nplanes = 21\nsweep = [0.0, 0.2]\n"
         f'[ground]\nsurface = 0.30\neps = "{eps.real}{eps.imag:+}j"\n', encoding="utf-8")
-    with ViewerProcess(["--settings", look]) as server:
-        browser.get(server.url)
-        wait_idle(browser)
+    with _page(browser, ["--settings", look]):
         for use, mode in (([0, 1, 2, 3, 4], "coherent"), ([0, 3, 4], "coherent"),
                           ([0, 3, 4], "amplitude")):
             set_model(browser, "views", "active", use)
@@ -250,9 +262,7 @@ def test_an_image_volume_shows_its_own_planes(rod, browser, tmp_path):
     _, h, sand = rod
     vol = hr.migrate(h, np.linspace(0.35, 0.45, 11), medium=sand, upsample=2)
     path = hr.save(vol, tmp_path / "rod_volume.nc")
-    with ViewerProcess([path]) as server:
-        browser.get(server.url)
-        wait_idle(browser)
+    with _page(browser, [path]):
         set_model(browser, "depth", "value", 40.0)  # range from the array, cm
         plane = vol.plane(0.40)
         np.testing.assert_allclose(shown_db(browser), _db(plane, np.abs(vol.data).max()),
