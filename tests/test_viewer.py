@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import os
 import warnings
 from pathlib import Path
 
@@ -114,6 +115,12 @@ def test_exports_never_replace_a_file(scene, tmp_path):
     assert first != second and first.exists() and second.exists()
     a, b = export_settings(s, tmp_path), export_settings(s, tmp_path)
     assert a != b and read_settings(a) == read_settings(b)
+    n = export_netcdf(S, s, tmp_path)
+    assert n.name == f"v0_{s.depth * 100:.1f}cm.nc"
+    assert not list(tmp_path.glob(".*"))  # no temporary file left
+    umask = os.umask(0)
+    os.umask(umask)
+    assert all(p.stat().st_mode & 0o777 == 0o666 & ~umask for p in (first, a, n))
 
 
 def test_view_refuses_a_file_it_cannot_read_with_the_clis_message(tmp_path):

@@ -1,12 +1,16 @@
 """What the viewer exports: a PNG of the look, the image as NetCDF, the settings TOML.
 
 The same functions serve ``holoradar render`` (a look reproduced in batch).
-Files are written atomically; an existing file is never replaced: the page
-picks the next free name (``..._2.png``).
+Files are written whole to a hidden temporary file, then linked under the
+first free name (``..._2.png`` when ``....png`` exists): an existing file is
+never replaced.
 """
 
 from __future__ import annotations
 
+import os
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -20,13 +24,26 @@ from .settings import ViewSettings, settings_toml
 __all__ = ["export_netcdf", "export_png", "export_settings", "look_figure", "look_history"]
 
 
-def _free_name(folder: Path, stem: str, suffix: str) -> Path:
-    p = folder / f"{stem}{suffix}"
-    i = 2
-    while p.exists():
-        p = folder / f"{stem}_{i}{suffix}"
-        i += 1
-    return p
+def _write_new(folder: Path, stem: str, suffix: str, write: Callable[[Path], Any]) -> Path:
+    """``write(tmp)`` to a hidden temporary file in ``folder``, then give it the first free
+    name of ``stem{suffix}``, ``stem_2{suffix}``, ...: a hard link is refused by the
+    system when the name exists, so no file is ever replaced, even one that appears
+    meanwhile. Returns the path written."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".tmp{suffix}", dir=folder)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        write(tmp_path)
+        i = 1
+        while True:
+            p = folder / (f"{stem}{suffix}" if i == 1 else f"{stem}_{i}{suffix}")
+            try:
+                os.link(tmp_path, p)
+                return p
+            except FileExistsError:
+                i += 1
+    finally:
+        tmp_path.unlink(missing_ok=True)
 
 
 def _stem(session: ViewSession, s: ViewSettings) -> str:
@@ -108,16 +125,17 @@ def export_png(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
     from ..atomic import write_atomic
     from ..plotting import to_png
 
-    return write_atomic(_free_name(folder, _stem(session, s), ".png"),
-                        to_png(look_figure(session, s)))
+    png = to_png(look_figure(session, s))
+    return _write_new(folder, _stem(session, s), ".png", lambda p: write_atomic(p, png))
 
 
 def export_netcdf(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
     """Write the shown plane (complex image) as NetCDF into ``folder``; returns the path."""
     from ...io import save
 
-    return save(session.image(s), _free_name(folder, _stem(session, s), ".nc"),
-                history=look_history(s))
+    img = session.image(s)
+    return _write_new(folder, _stem(session, s), ".nc",
+                      lambda p: save(img, p, overwrite=True, history=look_history(s)))
 
 
 def export_settings(s: ViewSettings, folder: Path) -> Path:
@@ -125,5 +143,5 @@ def export_settings(s: ViewSettings, folder: Path) -> Path:
     from ..atomic import write_atomic
 
     stem = Path(s.files[0]).stem if s.files else "view"
-    p = _free_name(folder, f"{stem}_look", ".toml")
-    return write_atomic(p, settings_toml(s, relative_to=folder).encode())
+    text = settings_toml(s, relative_to=folder).encode()
+    return _write_new(folder, f"{stem}_look", ".toml", lambda p: write_atomic(p, text))
