@@ -182,16 +182,23 @@ def test_glare_suppression_reports_the_apis_numbers(rod, rod_page, tmp_path):
 def test_exports_reproduce_the_look_in_batch(rod, rod_page, tmp_path):
     driver, _, out = rod_page
     set_model(driver, "depth", "value", 10.0)
-    before = set(out.iterdir())
+
+    def shown() -> set[Path]:  # what a user sees: a file appears whole, under its name
+        return {p for p in out.iterdir() if not p.name.startswith(".")}
+
+    before = shown()
     for what in ("png", "netcdf", "settings"):
         click_button(driver, f"export_{what}")
     t0 = time.monotonic()
-    while len(set(out.iterdir()) - before) < 3 and time.monotonic() - t0 < 30:
+    while (len(shown() - before) < 3 or model_value(driver, "exported").count("wrote") < 1
+           or any(p.name.startswith(".") for p in out.iterdir())) \
+            and time.monotonic() - t0 < 30:
         time.sleep(0.05)
-    new = sorted(set(out.iterdir()) - before)
+    new = sorted(shown() - before)
     assert sorted(p.suffix for p in new) == [".nc", ".png", ".toml"]
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]  # no temporary left
     toml = next(p for p in new if p.suffix == ".toml")
-    shown = hr.load(next(p for p in new if p.suffix == ".nc"))
+    image = hr.load(next(p for p in new if p.suffix == ".nc"))
     from click.testing import CliRunner
 
     from holoradar.app.cli import main
@@ -199,7 +206,7 @@ def test_exports_reproduce_the_look_in_batch(rod, rod_page, tmp_path):
     res = CliRunner().invoke(main, ["render", str(toml), "-o", str(tmp_path / "again.nc")])
     assert res.exit_code == 0, res.output
     again = hr.load(tmp_path / "again.nc")
-    np.testing.assert_array_equal(again.data, shown.data)
+    np.testing.assert_array_equal(again.data, image.data)
 
 
 def test_latency_of_the_slider_is_measured(rod_page):
