@@ -77,6 +77,7 @@ class ViewerPage:
         self.pending_plane = False
         self.pending_full = False
         self.frames = 0
+        self._syncing = False  # True while the page itself moves its widgets
         self._build()
         self._full()
 
@@ -110,7 +111,7 @@ class ViewerPage:
         step = max((b - a) / 500, 1e-4)
         self.depth = Slider(title=label, start=a * CM, end=b * CM, step=step * CM,
                             value=min(max(s.depth, a), b) * CM, name="depth", width=320)
-        self.depth.on_change("value", lambda _a, _o, _n: self._schedule_plane())
+        self.depth.on_change("value", lambda _a, _o, _n: self._syncing or self._schedule_plane())
         self.sweep_a = Spinner(title="sweep from (cm)", value=round(a * CM, 3), step=0.5,
                                width=100, format="0[.]00",
                                name="sweep_a")
@@ -118,7 +119,7 @@ class ViewerPage:
                                format="0[.]00",
                                name="sweep_b")
         for w in (self.sweep_a, self.sweep_b):
-            w.on_change("value", lambda _a, _o, _n: self._set_sweep())
+            w.on_change("value", lambda _a, _o, _n: self._syncing or self._set_sweep())
         # ground
         g = dict(s.ground) if s.ground is not None else {}
         opts = ["air (no ground)", "half-space"] + (["layers from file"] if self.ground_file
@@ -344,7 +345,7 @@ class ViewerPage:
     def _set_sweep(self) -> None:
         a, b = self.sweep_a.value, self.sweep_b.value
         if a is None or b is None or not b > a:
-            self._error("sweep: 'to' must be below 'from'")
+            self._error("sweep: 'to' must be deeper than 'from'")
             return
         self.depth.start, self.depth.end = a, b
         self.depth.step = max((b - a) / 500, 0.01)
@@ -364,11 +365,31 @@ class ViewerPage:
             except (TypeError, ValueError):
                 self._error("ground: give the surface range and eps', eps''")
                 return
+        try:
+            new = self.s.replace(ground=ground)
+            # With a ground the slider reads depth below the surface, without one range
+            # from the array: the same planes stay in view when the ground comes or goes.
+            shift = self.session.surface(self.s) - self.session.surface(new) \
+                if (ground is None) != (self.s.ground is None) else 0.0
+        except ValueError as exc:
+            self._error(str(exc))
+            return
         self.depth.title = "depth below the surface (cm)" if ground is not None \
             else "range z (cm)"
         for f in (self.xz, self.yz):
             f.yaxis.axis_label = "depth (cm)" if ground is not None else "range z (cm)"
-        self._set(ground=ground)
+        if shift:
+            a, b = (v + shift for v in (new.sweep or (0.0, 0.25)))
+            self._syncing = True
+            try:
+                self.sweep_a.value, self.sweep_b.value = round(a * CM, 3), round(b * CM, 3)
+                self.depth.start, self.depth.end = a * CM, b * CM
+                self.depth.value = (new.depth + shift) * CM
+            finally:
+                self._syncing = False
+            self._set(ground=ground, sweep=(a, b), depth=new.depth + shift)
+        else:
+            self._set(ground=ground)
 
     def _error(self, text: str) -> None:
         self.status.text = f'<span style="color:#b00">{text}</span>'
