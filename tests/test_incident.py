@@ -6,7 +6,11 @@ import numpy as np
 import pytest
 
 from conftest import F0
-from holoradar.physics.incident import incident_on_planes, incident_phasors
+from holoradar.physics.incident import (
+    incident_on_planes,
+    incident_phasors,
+    remove_incident_phase,
+)
 from holoradar.physics.medium import Medium
 from holoradar.physics.sources import GaussianBeam, PlaneWave, PointSource
 
@@ -29,7 +33,7 @@ def test_shared_quadrature_equals_each_sources_own(medium):
     # the unit phasors agree to 1e-6, well below what a wrong sign or a missing conjugate
     # would leave (order 1).
     srcs = [PointSource((0.0, -0.2, 0.0), pattern_exponent=4, axis=(0.0, 0.3, 1.0)),
-            PointSource((0.15, 0.1, 0.0)),
+            PointSource((0.15, 0.1, 0.0), amplitude=-2j),
             PointSource((0.0, 0.0, 0.05), axis=(0.0, 1.0, 0.0), dipole=True),
             PlaneWave(0.2, 0.0), GaussianBeam(0.1)]
     xs = np.linspace(-0.2, 0.2, 41)
@@ -39,6 +43,10 @@ def test_shared_quadrature_equals_each_sources_own(medium):
     for i, s in enumerate(srcs):
         ref = _unit(incident_on_planes(s, K, medium, xs, xs, zs))
         assert np.max(np.abs(u[i] - ref)) < 1e-6, i
+    # In place, plane by plane: the same phasors.
+    images = np.ones_like(u)
+    remove_incident_phase(images, srcs, K, medium, xs, xs, zs)
+    assert np.max(np.abs(images - u)) < 1e-12
 
 
 def test_free_space_point_sources():

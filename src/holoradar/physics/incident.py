@@ -218,8 +218,9 @@ def _direct_phasor(source: object, k: float, medium: Medium, x: np.ndarray, y: n
 def _radial_phasor(source: PointSource, zs: np.ndarray, r: np.ndarray, phase: np.ndarray,
                    amp: np.ndarray | None, sin_line: list[np.ndarray], rho: np.ndarray,
                    X: np.ndarray, Y: np.ndarray, j: int) -> np.ndarray:
-    # Only the phase is needed: one interpolation instead of two.
-    u = np.exp(-1j * np.interp(rho, r, phase[j]))
+    # Only the phase is needed: one interpolation instead of two; the source's complex
+    # amplitude is part of E0 and of its phase.
+    u = np.exp(-1j * np.interp(rho, r, phase[j])) * _unit(np.asarray(complex(source.amplitude)))
     if amp is not None:  # the field vanishes somewhere on the radial grid
         u[np.interp(rho, r, amp[j]) == 0] = 0
     if source.has_pattern:
