@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import warnings
 from pathlib import Path
 
@@ -83,6 +84,7 @@ def test_session_images_with_holoradars_functions(scene):
     ref, rep = hr.suppress_surface(views[0], sand, method="gaussian")
     np.testing.assert_array_equal(clean[0].data, ref.data)
     assert notes[0].removed_db == rep.glare_removed_db
+    assert notes[0].direct_db == rep.direct_removed_db
 
 
 def test_render_reproduces_an_exported_look(scene, tmp_path):
@@ -144,12 +146,20 @@ def test_server_binds_the_loopback_and_warns_otherwise(scene):
         warnings.simplefilter("error")
         server = make_server(S, s, export_dir=Path("."))
     try:
-        assert url_of(server, "127.0.0.1").startswith("http://127.0.0.1:")
+        bound = {sock.getsockname()[0] for sock in server._http._sockets.values()}
+        assert bound == {"127.0.0.1"}
+        assert url_of(server, "127.0.0.1") == f"http://127.0.0.1:{server.port}/"
     finally:
         server.stop()
     with pytest.warns(UserWarning, match="not the loopback"):
         server = make_server(S, s, host="0.0.0.0", export_dir=Path("."))
-    server.stop()
+    try:
+        # reachable under the machine's name, and its websocket accepts that origin
+        name = socket.gethostname()
+        assert url_of(server, "0.0.0.0") == f"http://{name}:{server.port}/"
+        assert f"{name}:{server.port}" in server._tornado.websocket_origins
+    finally:
+        server.stop()
 
 
 def test_an_image_file_and_a_survey_store_open_too(scene, tmp_path):

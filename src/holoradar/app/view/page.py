@@ -10,6 +10,7 @@ the next picture is for the latest depth, never a queue of stale ones.
 
 from __future__ import annotations
 
+import html
 import math
 import traceback
 from pathlib import Path
@@ -78,6 +79,7 @@ class ViewerPage:
         self.pending_full = False
         self.frames = 0
         self._syncing = False  # True while the page itself moves its widgets
+        self._full_ok = True  # the last sweep (sections, colour scale) succeeded
         self._build()
         self._full()
 
@@ -392,7 +394,7 @@ class ViewerPage:
             self._set(ground=ground)
 
     def _error(self, text: str) -> None:
-        self.status.text = f'<span style="color:#b00">{text}</span>'
+        self.status.text = f'<span style="color:#b00">{html.escape(text)}</span>'
 
     # ------------------------------------------------------------- scheduling
     def _schedule_full(self) -> None:
@@ -421,7 +423,8 @@ class ViewerPage:
     # ------------------------------------------------------------- pictures
     def _full(self) -> None:
         self.pending_full = False
-        if self._guard(self._compute_full):
+        self._full_ok = self._guard(self._compute_full)
+        if self._full_ok:
             self.status.text = ""
         self._plane()
 
@@ -441,9 +444,10 @@ class ViewerPage:
     def _plane(self) -> None:
         self.pending_plane = False
         self.s = self.s.replace(depth=float(self.depth.value) / CM)
-        if self._guard(self._compute_plane):
-            if self.status.text.startswith('<span style="color:#b00">'):
-                self.status.text = ""
+        # A good plane clears its own earlier error, never the sweep's.
+        if self._guard(self._compute_plane) and self._full_ok and \
+                self.status.text.startswith('<span style="color:#b00">'):
+            self.status.text = ""
 
     def _compute_plane(self) -> None:
         S, s = self.session, self.s
@@ -540,18 +544,27 @@ class ViewerPage:
             self.glare_report.text = ""
             return
         _, notes = S.cleaned(s)
+
+        def db_cell(v: float | None) -> str:
+            return "-" if v is None else f"{v:.1f}"
+
         rows = []
         for n in notes:
+            view = html.escape(n.view)
             if n.error is not None:
-                rows.append(f"<tr><td>{n.view}</td><td colspan=3 style='color:#b00'>"
-                            f"{n.error}</td></tr>")
+                rows.append(f"<tr><td>{view}</td><td colspan=4 style='color:#b00'>"
+                            f"{html.escape(n.error)}</td></tr>")
                 continue
-            rows.append(f"<tr><td>{n.view}</td><td>{n.removed_db:.1f}</td>"
-                        f"<td>{n.suppression_db:.1f}</td>"
+            rows.append(f"<tr><td>{view}</td><td>{db_cell(n.removed_db)}</td>"
+                        f"<td>{db_cell(n.direct_db)}</td><td>{db_cell(n.suppression_db)}</td>"
                         f"<td>{_fmt_eps(n.eps, n.eps_std)}</td></tr>")
+            if n.warning:
+                rows.append(f"<tr><td></td><td colspan=4 style='color:#a60'>"
+                            f"{html.escape(n.warning)}</td></tr>")
         self.glare_report.text = (
-            "<table><tr><th>view</th><th>removed (dB)</th><th>spot drop (dB)</th>"
-            "<th>eps from glare</th></tr>" + "".join(rows) + "</table>")
+            "<table><tr><th>view</th><th>glare removed (dB)</th><th>direct removed (dB)</th>"
+            "<th>spot drop (dB)</th><th>eps from glare</th></tr>" + "".join(rows)
+            + "</table>")
 
     # ------------------------------------------------------------- clicks
     def _tap(self, event: Any) -> None:

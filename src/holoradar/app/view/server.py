@@ -79,8 +79,7 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
     app = Application(FunctionHandler(make_doc))
     if not port:
         port = _free_port(host)
-    shown = f"[{host}]" if ":" in host else host
-    origins = [f"{shown}:{port}"] + ([f"localhost:{port}"] if is_loopback(host) else [])
+    origins = [f"{_bracket(n)}:{port}" for n in _names_of(host)]
     server = Server({"/": app}, address=host, port=port, allow_websocket_origin=origins,
                     num_procs=1)
     server.start()
@@ -97,10 +96,35 @@ def _free_port(host: str) -> int:
         return int(sock.getsockname()[1])
 
 
+def _bracket(name: str) -> str:
+    return f"[{name}]" if ":" in name else name
+
+
+def _names_of(host: str) -> list[str]:
+    """The names a browser may use for this server (its websocket ``Origin``): the host
+    itself, and for the loopback ``localhost``; for a wildcard address (0.0.0.0, ::) the
+    machine's name and addresses, since the server answers on all of them."""
+    import socket
+
+    names = [host]
+    if is_loopback(host):
+        names += ["localhost", "127.0.0.1"]
+    if host in ("0.0.0.0", "::", ""):
+        me = socket.gethostname()
+        names += [me, socket.getfqdn(), "localhost", "127.0.0.1"]
+        try:
+            names += sorted({str(a[4][0]) for a in socket.getaddrinfo(me, None)})
+        except OSError:  # a machine without a resolvable name: its name must do
+            pass
+    return list(dict.fromkeys(n for n in names if n))
+
+
 def url_of(server: Any, host: str) -> str:
-    """The page's address."""
-    shown = f"[{host}]" if ":" in host else host
-    return f"http://{shown}:{server.port}/"
+    """The page's address (for a wildcard host, under the machine's name)."""
+    import socket
+
+    name = socket.gethostname() if host in ("0.0.0.0", "::", "") else host
+    return f"http://{_bracket(name)}:{server.port}/"
 
 
 def open_in_browser(url: str, opener: Callable[[str], Any] = webbrowser.open) -> None:

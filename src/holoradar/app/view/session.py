@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..._validate import AliasingWarning
 from ...data.hologram import Hologram, Image
 from ...physics.medium import Medium
 from ...physics.sources import PointSource
@@ -37,10 +38,14 @@ __all__ = ["GlareSummary", "ViewSession"]
 class GlareSummary:
     """The glare suppression of one view, as the page reports it.
 
-    ``removed_db``: energy of the removed glare (and direct wave) over the energy
-    left, dB; ``suppression_db``: the mirror spot's peak before over after, dB;
+    ``removed_db``: energy of the removed glare over the energy left in the
+    hologram, dB; ``direct_db``: the same for the horn's direct wave (None when it
+    is kept); ``suppression_db``: the mirror spot's peak before over after, dB;
     ``eps``/``eps_std``: the ground's permittivity estimated from the glare and its
-    1-sigma uncertainty (real, imaginary); ``error``: why it could not be done.
+    1-sigma uncertainty (real, imaginary; None where the method gives none);
+    ``warning``: what the fit warned about (not converged, an implausible
+    reflection); ``error``: why it could not be done. With several frequencies,
+    energies are summed over them and the rest is the centre frequency's.
     """
 
     view: str
@@ -51,6 +56,18 @@ class GlareSummary:
     eps_std: tuple[float, float] | None = None
     mirror_position: tuple[float, float, float] | None = None
     error: str | None = None
+    direct_db: float | None = None
+    warning: str | None = None
+
+
+def _summed_db(left: list[float], removed_db: list[float | None]) -> float | None:
+    """Energy removed over energy left, dB, summed over frequencies, from each frequency's
+    energy left and its ratio in dB (None when a frequency removed nothing of the kind)."""
+    if any(r is None for r in removed_db):
+        return None
+    gone = sum(e * 10 ** (r / 10) for e, r in zip(left, removed_db, strict=True))  # type: ignore[operator]
+    total = sum(left)
+    return float(10 * np.log10(gone / total)) if total > 0 and gone > 0 else None
 
 
 class _Cache:
@@ -265,29 +282,32 @@ class ViewSession:
                                           "its surface and permittivity"))
                 continue
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
+                with warnings.catch_warnings(record=True) as said:
+                    warnings.simplefilter("always")
                     if h.is_wideband:  # one fit per frequency: the glare's phase moves with f
                         parts = [suppress_surface(h.at_frequency(i), medium, method=s.glare,
                                                   direct=s.direct) for i in range(h.nf)]
                         clean = h.with_data(np.stack([c.data for c, _ in parts], axis=-3))
                         rep = parts[h.nf // 2][1]
-                        left = np.linalg.norm(clean.data) ** 2
-                        gone = np.linalg.norm(h.data - clean.data) ** 2
-                        removed = float(10 * np.log10(gone / left)) if left > 0 else None
+                        left = [float(np.linalg.norm(c.data)) ** 2 for c, _ in parts]
+                        removed = _summed_db(left, [r.glare_removed_db for _, r in parts])
+                        direct = _summed_db(left, [r.direct_removed_db for _, r in parts])
                     else:
                         clean, rep = suppress_surface(h, medium, method=s.glare,
                                                       direct=s.direct)
-                        removed = rep.glare_removed_db
+                        removed, direct = rep.glare_removed_db, rep.direct_removed_db
             except ValueError as exc:
                 out.append(h)
                 notes.append(GlareSummary(name, s.glare, error=str(exc)))
                 continue
+            heard = sorted({str(w.message) for w in said
+                            if not issubclass(w.category, AliasingWarning)})
             out.append(clean)
-            notes.append(GlareSummary(name, s.glare, removed_db=removed,
+            notes.append(GlareSummary(name, s.glare, removed_db=removed, direct_db=direct,
                                       suppression_db=rep.glare_suppression_db, eps=rep.eps,
                                       eps_std=rep.eps_std,
-                                      mirror_position=rep.mirror_position))
+                                      mirror_position=rep.mirror_position,
+                                      warning="; ".join(heard) or None))
         return out, notes
 
     # ----------------------------------------------------------------- images
