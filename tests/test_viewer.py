@@ -61,6 +61,8 @@ def test_settings_round_trip_through_toml(tmp_path):
     ("[camera]\n", r"unknown entries \['camera'\]"),
     ("files = 'a.nc'\n", r"files must be a list of file names"),
     ("depth = = 1\n", r"is not valid TOML"),
+    ("[image]\nsweep = 0.3\n", r"image.sweep must be \[first, last\] depths in metres"),
+    ("[display]\nsection = 1\n", r"display.section must be \[x, y\] in metres"),
 ])
 def test_bad_settings_name_the_key_and_the_expected_form(tmp_path, text, message):
     p = tmp_path / "look.toml"
@@ -183,3 +185,16 @@ def test_an_image_file_and_a_survey_store_open_too(scene, tmp_path):
     assert S.kind == "survey"
     np.testing.assert_array_equal(S.image(S.default_settings().replace(depth=0.42)).data,
                                   mosaic(store, 0.42).data)
+
+
+def test_exports_without_hard_links_copy_without_replacing(scene, tmp_path, monkeypatch):
+    # A file system without hard links (FAT, some shares): the same rules by exclusive copy.
+    def no_links(*_a, **_k):
+        raise OSError("hard links not supported")
+
+    monkeypatch.setattr(os, "link", no_links)
+    paths, _, _ = scene
+    s = ViewSession(paths[:1]).default_settings(ground=SAND)
+    a, b = export_settings(s, tmp_path), export_settings(s, tmp_path)
+    assert a != b and read_settings(a) == read_settings(b)
+    assert not list(tmp_path.glob(".*"))

@@ -49,8 +49,9 @@ def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[s
               help="Start from a look saved by the page's 'export settings' (its files are "
                    "opened when no FILES are given).")
 @click.option("--depth", type=float, default=None,
-              help="First depth below the surface (range without a ground), m; default the "
-                   "brightest plane of the sweep.")
+              help="First depth below the surface (range without a ground), m; default: "
+                   "for holograms the brightest plane of the sweep, for an image its middle "
+                   "plane, for a survey its first.")
 @click.option("--glare", type=click.Choice(["off", "gaussian", "image_source", "cut"]),
               default=None, help="Glare suppression to start with (default off).")
 @click.option("--host", default="127.0.0.1", show_default=True,
@@ -104,6 +105,9 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         s = s.replace(glare=glare)
     if depth is not None:
         s = s.replace(depth=depth)
+        if s.sweep is not None and not s.sweep[0] <= depth <= s.sweep[1]:
+            # the slider spans the sweep: widen it to the depth asked for
+            s = s.replace(sweep=(min(s.sweep[0], depth), max(s.sweep[1], depth)))
     elif base is None and session.kind == "holograms":
         from ...analysis.metrics import peak_position
 
@@ -154,7 +158,8 @@ def render(settings_file: Path, out: Path, png: bool, force: bool, layout: str |
 
     s = read_settings(settings_file)
     if not s.files:
-        raise click.BadParameter(f"{settings_file.name} names no files", param_hint="SETTINGS")
+        raise click.BadParameter(f"{settings_file.name} names no files",
+                                 param_hint="SETTINGS_FILE")
     inputs = [settings_file, *(Path(f) for f in s.files)]
     check_output(out, suffixes=[".nc", ".nc4"], inputs=inputs, overwrite=force, name="--out")
     if png:
@@ -163,7 +168,7 @@ def render(settings_file: Path, out: Path, png: bool, force: bool, layout: str |
     for f in s.files:
         if not Path(f).exists():
             raise click.BadParameter(f"{f} (named in {settings_file.name}) does not exist",
-                                     param_hint="SETTINGS")
+                                     param_hint="SETTINGS_FILE")
     session = ViewSession([Path(f) for f in s.files], layout=layout, check=check)
     img = session.image(s)
     ref = float(np.abs(img.data).max()) or 1.0

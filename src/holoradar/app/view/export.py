@@ -42,6 +42,20 @@ def _write_new(folder: Path, stem: str, suffix: str, write: Callable[[Path], Any
                 return p
             except FileExistsError:
                 i += 1
+            except OSError:  # no hard links here (FAT, some network shares): copy, exclusively
+                try:
+                    fh = open(p, "xb")  # closed below; removed if unfinished
+                except FileExistsError:
+                    i += 1
+                    continue
+                try:
+                    with fh:
+                        fh.write(tmp_path.read_bytes())
+                    os.chmod(p, tmp_path.stat().st_mode & 0o777)
+                except BaseException:
+                    p.unlink(missing_ok=True)
+                    raise
+                return p
     finally:
         tmp_path.unlink(missing_ok=True)
 

@@ -360,8 +360,14 @@ class ViewSession:
         ``s.sweep`` (depths)."""
         if self.volume is not None:
             return self.volume
-        if self.store is not None:
-            return self.image(s)
+        if self.store is not None:  # every plane of the store's mosaic: one colour scale
+            def stack() -> Image:
+                planes = [self.image(s, float(z)) for z in self.survey_z]
+                p0 = planes[0]
+                return Image(np.stack([p.data for p in planes]), p0.x, p0.y,
+                             self.survey_z.copy(), p0.frequency, p0.method)
+
+            return self._sweeps.get(("mosaic",), stack)
         a, b = s.sweep if s.sweep is not None else (0.0, 0.25)
         zs = self.surface(s) + np.linspace(a, b, s.planes)
         return self._sweeps.get((self._key(s), a, b, s.planes), lambda: self._form(s, zs))

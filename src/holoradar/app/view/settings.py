@@ -107,7 +107,8 @@ def _check(s: ViewSettings) -> None:
         _fail("image.upsample", "an integer from 1 to 16", s.upsample)
     if s.fov not in ("full", "aperture"):
         _fail("image.fov", "'full' or 'aperture'", s.fov)
-    if s.sweep is not None and not (len(s.sweep) == 2 and all(map(_finite, s.sweep))
+    if s.sweep is not None and not (isinstance(s.sweep, tuple | list) and len(s.sweep) == 2
+                                    and all(map(_finite, s.sweep))
                                     and s.sweep[1] > s.sweep[0]):
         _fail("image.sweep", "[first, last] depths in metres, last > first", s.sweep)
     if not isinstance(s.planes, int) or isinstance(s.planes, bool) or not 2 <= s.planes <= 1000:
@@ -130,7 +131,9 @@ def _check(s: ViewSettings) -> None:
         _fail("display.db_range", "a number of dB from 1 to 200", s.db_range)
     if s.plane not in ("image", "mirror"):
         _fail("display.plane", "'image' or 'mirror'", s.plane)
-    if s.section is not None and not (len(s.section) == 2 and all(map(_finite, s.section))):
+    if s.section is not None and not (isinstance(s.section, tuple | list)
+                                      and len(s.section) == 2
+                                      and all(map(_finite, s.section))):
         _fail("display.section", "[x, y] in metres", s.section)
     if s.ground is not None and not isinstance(s.ground, Mapping):
         _fail("ground", "a table (surface, eps or [[ground.layer]])", s.ground)
