@@ -7,7 +7,7 @@ sand's glare and the horn's direct wave in every view (holoradar's forward
 model). Writes ``viewer_scene/view0.nc`` ... ``view5.nc`` and
 ``viewer_scene/look.toml``: the settings the page's "export settings" writes,
 here the coherent sum of the six views 12 cm deep with the glare removed by the
-Gaussian-beam fit.
+Gaussian-beam fit. Files that exist already are kept, not overwritten.
 
 Run: ``.venv/bin/python examples/viewer_scene.py [out_dir]``, then
 
@@ -42,11 +42,13 @@ def main(out: Path) -> list[Path]:
             h = hr.simulate(hr.Scene(sand, horn, objects), hr.Aperture.grid(16, 0.025),
                             9.9e9, include_direct=True)
             p = out / f"view{i}.nc"
-            paths.append(hr.save(h, p, overwrite=True))
+            paths.append(p if p.exists() else hr.save(h, p))  # an existing file is kept
     look = ViewSettings(files=tuple(str(p) for p in paths), depth=0.12, glare="gaussian",
                         ground={"surface": SURFACE, "eps": f"{EPS.real}{EPS.imag:+}j"})
-    (out / "look.toml").write_text(settings_toml(look, relative_to=out), encoding="utf-8")
-    return [*paths, out / "look.toml"]
+    toml = out / "look.toml"
+    if not toml.exists():
+        toml.write_text(settings_toml(look, relative_to=out), encoding="utf-8")
+    return [*paths, toml]
 
 
 if __name__ == "__main__":

@@ -92,6 +92,24 @@ def test_array_geometry_frequencies_add_after_the_incident_phase():
         hr.migrate(h.replace(source=None), 0.25)
 
 
+def test_full_field_of_view_over_a_band_shares_one_grid():
+    # fov="full" shows the padded grid, which grows with the wavelength and the depth:
+    # the frequencies of a band must share the largest one, and still focus on the target
+    # (same criterion as above: a quarter of the range resolution c/(2B)). With a pitch
+    # above lambda/2 the padding needed, lambda z / dx^2, differs across 8-12 GHz.
+    ap = hr.Aperture.grid(20, 0.02)
+    target = (0.0, 0.0, 0.50)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget(target)]), ap, FREQS)
+    zs = np.linspace(0.46, 0.54, 81)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hr.AliasingWarning)  # the pitch, on purpose
+        img = hr.migrate(h, zs, fov="full")
+        aperture = hr.migrate(h, zs)
+    assert img.data.shape[-1] > aperture.data.shape[-1]
+    assert abs(peak_position(img)[2] - target[2]) < hr.theory.range_resolution(
+        4e9, monostatic=False) / 4
+
+
 def test_wideband_bad_input():
     x = np.arange(8) * 0.005
     with pytest.raises(ValueError, match="frequency axis third from last"):

@@ -388,6 +388,15 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
             return Image(img.data[..., 0, :, :], img.x, img.y, img.z, img.frequency,
                          img.method, has_z_axis=False)
         return img
+    if kw.get("fov") == "full" and kw.get("pad", True) is True and kw.get("frame") != "ground":
+        # The full field of view is the padded grid, whose size grows with the wavelength:
+        # one padding factor for the whole band (the largest any frequency needs) gives
+        # every frequency the same pixels to add.
+        n = hologram.data.shape[-2:]
+        need = [padded_shape(n, True, pitch=hologram.pitch, wavelength=C0 / f / (
+            2 if hologram.monostatic else 1), z_max=float(zs_all.max()))
+            for f in hologram.frequencies]
+        kw["pad"] = max(m / s for shape in need for m, s in zip(shape, n, strict=True))
     acc: np.ndarray | None = None
     parts = []
     img = None

@@ -129,6 +129,22 @@ def incident_phasors(sources: list[object], k: float, medium: Medium, x: np.ndar
     only by the lateral shift of the source. Other sources go through
     :func:`incident_on_plane` plane by plane.
 
+    Parameters
+    ----------
+    sources : list of PlaneWave, PointSource or GaussianBeam
+        The views' illuminations (complex amplitudes included in the phase).
+    k : float
+        Wavenumber in air, rad/m.
+    medium : Medium
+    x, y : ndarray
+        Pixel coordinates, metres.
+    z : float or ndarray
+        Ranges of the planes, metres.
+
+    Returns
+    -------
+    ndarray, complex, shape (len(sources), len(z), y.size, x.size)
+
     Examples
     --------
     >>> m = Medium.half_space(0.3, 2.5)
@@ -154,6 +170,18 @@ def remove_incident_phase(images: np.ndarray, sources: list[object], k: float,
 
     The same phasors as :func:`incident_phasors`, made one plane at a time (a depth
     sweep of many views never holds them all).
+
+    Parameters
+    ----------
+    images : ndarray, complex, shape (len(sources), len(z), y.size, x.size)
+        Changed in place.
+    sources, k, medium, x, y, z
+        As for :func:`incident_phasors` (rad/m, metres).
+
+    Raises
+    ------
+    ValueError
+        ``images`` of another shape.
 
     Examples
     --------

@@ -16,7 +16,25 @@ __all__ = ["COMMANDS", "ground_from_options"]
 
 def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[str, Any] | None:
     """The ground flags as a table of a scene file (``surface``/``eps`` or ``layer``), checked
-    by building the medium; None without a ground."""
+    by building the medium; None without a ground.
+
+    Parameters
+    ----------
+    spec : dict
+        The medium options as the CLI parsed them (``eps``, ``z_surface``,
+        ``tan_delta``, ``sigma``, ``layers``, ``medium_file``; metres).
+    frequency : float or None
+        Hz, for a loss given as a conductivity (default 10 GHz where unknown).
+
+    Returns
+    -------
+    dict or None
+
+    Raises
+    ------
+    click.BadParameter, ValueError
+        A ground the medium options refuse, with their message.
+    """
     from ...model.scene_file import medium_from_mapping
     from .common import medium_from_options
 

@@ -135,7 +135,22 @@ def look_history(s: ViewSettings) -> list[dict[str, Any]]:
 
 
 def export_png(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
-    """Write the look as a PNG into ``folder`` under a new name; returns the path."""
+    """Write the look's figure (:func:`look_figure`) as a PNG into ``folder``.
+
+    Parameters
+    ----------
+    session : ViewSession
+    s : ViewSettings
+        The look.
+    folder : Path
+        An existing folder; the name is ``<first file>_<depth>cm.png``, or the first
+        free ``..._2.png``, ``..._3.png``: no file is replaced.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from ..atomic import write_atomic
     from ..plotting import to_png
 
@@ -144,7 +159,19 @@ def export_png(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
 
 
 def export_netcdf(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
-    """Write the shown plane (complex image) as NetCDF into ``folder``; returns the path."""
+    """Write the shown plane (the complex image, metres and hertz) as a holoradar NetCDF
+    file into ``folder``, with the settings in its history.
+
+    Parameters
+    ----------
+    session, s, folder
+        As for :func:`export_png` (suffix ``.nc``).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from ...io import save
 
     img = session.image(s)
@@ -153,7 +180,20 @@ def export_netcdf(session: ViewSession, s: ViewSettings, folder: Path) -> Path:
 
 
 def export_settings(s: ViewSettings, folder: Path) -> Path:
-    """Write the settings TOML (``holoradar render`` reads it) into ``folder``."""
+    """Write the settings as TOML (``holoradar render`` reads it) into ``folder``.
+
+    Parameters
+    ----------
+    s : ViewSettings
+    folder : Path
+        File names in the TOML are relative to it where possible; the name is
+        ``<first file>_look.toml`` or the first free ``..._2.toml``.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from ..atomic import write_atomic
 
     stem = Path(s.files[0]).stem if s.files else "view"

@@ -272,7 +272,8 @@ class ViewerPage:
                                        text_font_size="9pt"))
         # the cursor readout: x, y from the pointer, the value from the shown plane
         self.fig.js_on_event("mousemove", CustomJS(args={"src": self.src, "div": self.readout,
-                                                         "depth": self.depth}, code="""
+                                                         "depth": self.depth,
+                                                         "which": self.which}, code="""
             const d = src.data; const w = d.dw[0], h = d.dh[0];
             const shape = d.db[0].shape || [0, 0];
             const i = Math.floor((cb_obj.y - d.y[0]) / h * shape[0]);
@@ -281,8 +282,12 @@ class ViewerPage:
             if (i >= 0 && j >= 0 && i < shape[0] && j < shape[1]) {
                 v = Number(d.db[0][i * shape[1] + j]).toFixed(1) + ' dB';
             }
+            // the slider reads depth below the surface, or range without a ground; the
+            // mirror-source plane has its own range (in the plot's corner)
+            const word = depth.title.startsWith('depth') ? 'depth' : 'range';
+            const z = which.active == 1 ? '' : `${word} = ${depth.value.toFixed(1)} cm, `;
             div.text = `cursor: x = ${cb_obj.x.toFixed(1)} cm, y = ${cb_obj.y.toFixed(1)} cm, `
-                     + `depth = ${depth.value.toFixed(1)} cm, |E| = ${v}`;
+                     + `${z}|E| = ${v}`;
         """))
         controls = column(
             self.info, self.status, self.depth, row(self.sweep_a, self.sweep_b),
@@ -425,7 +430,9 @@ class ViewerPage:
         self.pending_full = False
         self._full_ok = self._guard(self._compute_full)
         if self._full_ok:
-            self.status.text = ""
+            heard = sorted(self.session.heard)
+            self.status.text = "".join(f'<div style="color:#a60">note: {html.escape(w)}</div>'
+                                       for w in heard)
         self._plane()
 
     def _compute_full(self) -> None:
@@ -507,8 +514,15 @@ class ViewerPage:
 
             x, y, _ = peak_position(vol)
         xz, yz = sections(vol, x, y)
-        surf = S.surface(s)
-        z0, dz = _edges(vol.z - surf)
+        z = vol.z - S.surface(s)
+        steps = np.diff(z)
+        if steps.size > 1 and not np.allclose(steps, steps[0], rtol=1e-6):
+            # An image file's planes may be unevenly spaced; the page draws a regular
+            # grid: each row shows the nearest plane.
+            even = np.linspace(z[0], z[-1], max(64, 2 * z.size))
+            near = np.abs(even[:, None] - z[None, :]).argmin(axis=1)
+            xz, yz, z = xz[near], yz[near], even
+        z0, dz = _edges(z)
         for src, a, c in ((self.xz_src, xz, vol.x), (self.yz_src, yz, vol.y)):
             c0, w = _edges(c)
             src.data = {"image": [scaled(a, self.ref, s.scale, s.db_range).astype(np.float32)],

@@ -165,7 +165,7 @@ class ViewSession:
                     self.views.append(obj.with_data(flat[i]))
                     self.names.append(p.name if n == 1 else f"{p.name}[{i}]")
         self.kind = "image" if self.volume is not None else "holograms"
-        if self.views:
+        if len(self.views) > 1:  # one view needs no source: it is imaged alone
             from ...imaging.synthesis import _check_views
 
             try:
@@ -175,6 +175,7 @@ class ViewSession:
         self._caches()
 
     def _caches(self) -> None:
+        self.heard: set[str] = set()  # warnings of the imaging, for the page to show
         self._clean = _Cache(8)
         self._planes = _Cache(256)
         self._sweeps = _Cache(4)
@@ -323,15 +324,21 @@ class ViewSession:
         kw: dict[str, Any] = {"upsample": s.upsample, "frame": s.frame}
         if s.frame == "aperture":
             kw["fov"] = s.fov
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            if len(use) == 1:
-                return migrate(use[0], z, medium=medium, combine=combine, **kw)
-            if combine == "incoherent" and use[0].is_wideband:
-                raise ValueError("views.frequency: the incoherent sum of frequencies is for "
-                                 "one view; several views add their coherent images (choose "
-                                 "'coherent' or one frequency)")
-            return synthesize(use, z, medium=medium, mode=s.mode, **kw)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            try:
+                if len(use) == 1:
+                    return migrate(use[0], z, medium=medium, combine=combine, **kw)
+                if combine == "incoherent" and use[0].is_wideband:
+                    raise ValueError("views.frequency: the incoherent sum of frequencies is "
+                                     "for one view; several views add their coherent images "
+                                     "(choose 'coherent' or one frequency)")
+                return synthesize(use, z, medium=medium, mode=s.mode, **kw)
+            finally:
+                # What the imaging warned about (an assumed illumination, say) is kept for
+                # the page; aliasing of the array's pitch is known and said in its info.
+                self.heard |= {str(w.message) for w in said
+                               if not issubclass(w.category, AliasingWarning)}
 
     def _key(self, s: ViewSettings) -> tuple[Any, ...]:
         return (self._glare_key(s), s.views, s.mode, s.upsample, s.fov, s.frame)

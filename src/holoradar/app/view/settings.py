@@ -154,6 +154,15 @@ def read_settings(path: str | Path) -> ViewSettings:
 
     Relative file names are taken from the TOML's folder.
 
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file (format in this module's docstring).
+
+    Returns
+    -------
+    ViewSettings
+
     Raises
     ------
     ValueError
@@ -213,6 +222,17 @@ def _plain(v: Any) -> Any:
 
 def settings_toml(s: ViewSettings, *, relative_to: Path | None = None) -> str:
     """The TOML text of ``s`` (file names relative to ``relative_to`` where possible).
+
+    Parameters
+    ----------
+    s : ViewSettings
+    relative_to : Path, optional
+        The folder the TOML will live in.
+
+    Returns
+    -------
+    str
+        What :func:`read_settings` reads back to ``s``.
 
     Examples
     --------
