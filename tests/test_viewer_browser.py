@@ -180,6 +180,56 @@ def test_glare_suppression_reports_the_apis_numbers(rod, rod_page, tmp_path):
     set_model(driver, "glare", "value", "off")
 
 
+def test_mirror_source_plane_shows_the_glare_where_geometry_puts_it(rod, rod_page):
+    # The dipole 10 cm above the sand (range 0.20 m) has its image in the surface (0.30 m)
+    # at range 2 * 0.30 - 0.20 = 0.40 m, below the dipole at (-0.20, 0): the glare focuses
+    # there. The mirror lies over the aperture's edge, where a focus is still found to
+    # better than a quarter wavelength (0.76 cm).
+    _, h, _ = rod
+    driver, _, _ = rod_page
+    set_model(driver, "glare", "value", "off")
+    set_model(driver, "plane", "active", 1)
+    try:
+        m = re.search(r"range ([\d.]+) cm\npeak: x = (-?[\d.]+) cm, y = (-?[\d.]+) cm",
+                      model_value(driver, "peak"))
+        assert m, model_value(driver, "peak")
+        assert abs(float(m[1]) - 40.0) < 0.005 + 1e-9
+        quarter = 100 * hr.C0 / h.frequency / 4
+        assert np.hypot(float(m[2]) + 20.0, float(m[3])) < quarter
+        assert not _console_errors(driver)
+    finally:
+        set_model(driver, "plane", "active", 0)
+
+
+def test_linear_scale_and_switching_the_ground_off(rod, rod_page):
+    _, h, sand = rod
+    driver, _, _ = rod_page
+    set_model(driver, "depth", "value", 10.0)
+    set_model(driver, "scale", "active", 1)  # linear: |E| / the sweep's peak
+    try:
+        _, api_db = _api_plane(h, sand, 0.10)
+        lin = np.asarray(driver.execute_script(
+            "return Array.from(Bokeh.documents[0].get_model_by_name('image_source')"
+            ".data.lin[0])")).reshape(api_db.shape)
+        # float32 carries 24 bits: 1e-7 of a ratio <= 1
+        np.testing.assert_allclose(lin, 10 ** (api_db / 20), rtol=0, atol=1e-6)
+    finally:
+        set_model(driver, "scale", "active", 0)
+    # Without a ground the slider reads range: the same plane stays in view (0.40 m),
+    # now imaged through air.
+    set_model(driver, "ground", "value", "air (no ground)")
+    try:
+        assert model_value(driver, "depth", "value") == pytest.approx(40.0)
+        air = hr.migrate(h, 0.40, upsample=4, fov="full")
+        sweep = hr.migrate(h, np.linspace(0.30, 0.55, 61), upsample=4, fov="full")
+        np.testing.assert_allclose(shown_db(driver), _db(air, np.abs(sweep.data).max()),
+                                   rtol=0, atol=PICTURE_DB_TOL)
+    finally:
+        set_model(driver, "ground", "value", "half-space")
+    assert model_value(driver, "depth", "value") == pytest.approx(10.0)
+    assert not _console_errors(driver)
+
+
 def test_exports_reproduce_the_look_in_batch(rod, rod_page, tmp_path):
     driver, _, out = rod_page
     set_model(driver, "depth", "value", 10.0)
