@@ -54,10 +54,26 @@ def test_settings_round_trip_through_toml(tmp_path):
     assert read_settings(p) == s
 
 
+def test_settings_take_lists_and_keep_every_digit_of_a_permittivity(scene, tmp_path):
+    # As TOML and JSON give them: lists become the fields' tuples.
+    s = ViewSettings(files=["a.nc"], views=[0, 1], sweep=[0.0, 0.2], section=[0.0, 0.01])
+    assert (s.files, s.views, s.sweep, s.section) == (("a.nc",), (0, 1), (0.0, 0.2),
+                                                      (0.0, 0.01))
+    # A complex permittivity written to a saved look comes back to the last bit, so that
+    # the look's image is reproduced bit for bit.
+    eps = 2.123456789123 + 0.0123456789123j
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    s = S.default_settings(ground={"surface": 0.3, "eps": eps})
+    back = read_settings(export_settings(s, tmp_path))
+    assert complex(S.medium(back).eps[1]) == eps
+
+
 @pytest.mark.parametrize(("text", "message"), [
     ("[image]\ndepth = 'deep'\n", r"image.depth must be a depth in metres, got 'deep'"),
     ("[glare]\nmethod = 'magic'\n", r"glare.method must be 'off' or 'gaussian'"),
     ("[views]\nuse = []\n", r"views.use must be a non-empty list"),
+    ("[views]\nuse = [0, 0]\n", r"views.use must be view indices each named once"),
     ("[image]\nzoom = 2\n", r"unknown keys \['zoom'\] in \[image\]; expected depth"),
     ("[camera]\n", r"unknown entries \['camera'\]"),
     ("files = 'a.nc'\n", r"files must be a list of file names"),
@@ -234,3 +250,96 @@ def test_several_frequencies_and_a_tilted_array(tmp_path):
         S.image(s.replace(depth=0.11)).data,
         hr.migrate(t, 0.51, medium=hr.Medium.half_space(0.4, 2.5 + 0.0125j), frame="ground",
                    upsample=4).data)
+
+
+def test_the_mirror_plane_is_the_same_whichever_planes_are_chosen(scene):
+    # The glare's mirror-source plane is imaged in the array's own frame (an array facing
+    # the ground): the choice of level planes for the image must not change it, nor may
+    # a picture cached for one choice be shown for the other.
+    paths, views, _ = scene
+    S = ViewSession(paths[:1])
+    s = S.default_settings(ground=SAND).replace(plane="mirror")
+    zm = 2 * 0.30 - (-0.05)
+    want = hr.migrate(views[0], zm, upsample=4, fov="full").data
+    np.testing.assert_array_equal(S.image(s.replace(frame="ground")).data, want)
+    np.testing.assert_array_equal(S.image(s).data, want)
+    np.testing.assert_array_equal(S.image(s.replace(frame="ground", fov="aperture")).data,
+                                  hr.migrate(views[0], zm, upsample=4, fov="aperture").data)
+
+
+def test_notes_belong_to_the_settings_shown(tmp_path):
+    # Frequencies summed without a source assume a plane wave (the imaging warns); one
+    # frequency assumes nothing: its look must not carry the other's note.
+    x = np.arange(16) * 0.01
+    h = hr.Hologram(np.ones((3, 16, 16), complex), x, x, [9e9, 9.9e9, 10.8e9])
+    S = ViewSession([hr.save(h, tmp_path / "band.nc")])
+    s = S.default_settings(ground=SAND)
+    assert any("plane wave" in n for n in S.notes(s))
+    assert S.notes(s.replace(frequency=1)) == ()
+    assert any("plane wave" in n for n in S.notes(s))  # and again from the cache
+
+
+def test_exports_without_hard_links_leave_nothing_when_the_rename_fails(scene, tmp_path,
+                                                                         monkeypatch):
+    # The name is claimed empty, then the finished file renamed onto it: a failed rename
+    # must take the claim back (nothing half-written stays under the export's name).
+    def no_links(*_a, **_k):
+        raise OSError("hard links not supported")
+
+    real_replace = os.replace
+
+    def broken_replace(src, dst, *a, **k):
+        if not Path(dst).name.startswith("."):  # the temporary file is still written
+            raise OSError("disk gone")
+        return real_replace(src, dst, *a, **k)
+
+    monkeypatch.setattr(os, "link", no_links)
+    monkeypatch.setattr(os, "replace", broken_replace)
+    paths, _, _ = scene
+    s = ViewSession(paths[:1]).default_settings(ground=SAND)
+    with pytest.raises(OSError, match="disk gone"):
+        export_settings(s, tmp_path)
+    assert not list(tmp_path.iterdir())
+
+
+def test_page_keeps_a_layered_ground_and_reports_bad_widget_values(scene, tmp_path):
+    # Without a browser: the page's Python side on a bare Bokeh document.
+    from bokeh.document import Document
+
+    from holoradar.app.view.page import ViewerPage
+
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    layers = {"layer": [{"top": 0.30, "eps": 2.5 + 0.01j}, {"top": 0.45, "eps": 4.0}]}
+    page = ViewerPage(Document(), S, S.default_settings(ground=layers), tmp_path)
+    # a look saved with layers offers them, and touching a ground knob keeps them
+    assert page.ground_kind.value == "layers from file"
+    page.eps_re.value = 3.0
+    assert page.s.ground == layers
+    assert S.surface(page.s) == pytest.approx(0.30)
+    # an emptied spinner is said on the page, not raised in the server's callback
+    page.db_range.value = None
+    assert "dB range" in page.status.text and page.s.db_range == 30.0
+    # a failed export is said on the page too, and file names are escaped
+    page.export_dir = tmp_path / "gone"
+    page._export("settings")
+    assert "export settings:" in page.status.text
+    assert "<b>v0.nc</b>" in page.info.text
+
+
+def test_view_names_the_flag_that_is_wrong(scene, tmp_path):
+    paths, views, sand = scene
+    args = ["view", str(paths[0]), "--no-browser", "--eps", "2.5", "--z-surface", "0.3"]
+    r = CliRunner().invoke(main, [*args, "--host", "::1"])
+    assert r.exit_code == 2 and "--host" in r.output and "IPv6" in r.output
+    r = CliRunner().invoke(main, [*args, "--depth", "nan"])
+    assert r.exit_code == 2 and "--depth" in r.output
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        r = CliRunner().invoke(main, [*args, "--port", str(busy.getsockname()[1])])
+    assert r.exit_code == 2 and "--port" in r.output and "in use" in r.output
+    vol = hr.save(hr.migrate(views[0], [0.40, 0.42], medium=sand), tmp_path / "vol.nc")
+    r = CliRunner().invoke(main, ["view", str(vol), "--no-browser", "--eps", "2.5",
+                                  "--z-surface", "0.3"])
+    assert r.exit_code == 2 and "apply to holograms" in r.output

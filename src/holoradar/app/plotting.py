@@ -17,11 +17,10 @@ from matplotlib.patches import Rectangle
 
 from ..analysis.theory import SpectralWindow
 from ..data.hologram import Hologram, Image
+from .view.display import CM, scaled
 
 __all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_planes", "plot_section",
            "plot_spectrum", "to_png"]
-
-CM = 100.0
 
 
 def to_png(fig: Figure, dpi: int = 110) -> bytes:
@@ -237,9 +236,8 @@ def plot_oblique_plan(plan: Any, aperture: Any, source: Any, medium: Any,
 def _scaled(a: np.ndarray, ref: float, db_range: float | None) -> tuple[np.ndarray, float,
                                                                        float, str]:
     if db_range is None:
-        return a / ref, 0.0, 1.0, "|E| / max"
-    return (20 * np.log10(np.maximum(a / ref, 10 ** (-db_range / 20))), -db_range, 0.0,
-            "|E| (dB re max)")
+        return scaled(a, ref, "linear", 0.0), 0.0, 1.0, "|E| / max"
+    return scaled(a, ref, "db", db_range), -db_range, 0.0, "|E| (dB re max)"
 
 
 def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = None,

@@ -146,11 +146,16 @@ def medium_options(fn: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
-def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
-    """The Medium the flags describe (None: free space)."""
+def ground_table_from_options(spec: dict[str, Any]) -> dict[str, Any] | None:
+    """The ground the flags describe, as a scene file's ``[ground]`` table (``surface`` and
+    ``eps``, or ``layer`` tables; a ``--medium`` file's own table); None: free space.
+
+    Checks how the flags combine and their forms; :func:`medium_from_options` builds
+    the medium from it (and checks the values).
+    """
     import tomllib
 
-    from ...model.scene_file import medium_from_mapping, parse_complex
+    from ...model.scene_file import parse_complex
 
     eps, zs, td, sg = spec["eps"], spec["z_surface"], spec["tan_delta"], spec["sigma"]
     layers, mfile = spec["layers"], spec["medium_file"]
@@ -161,11 +166,10 @@ def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
             raise click.BadParameter("--medium describes the whole ground: give no other "
                                      "ground flag", param_hint="--medium")
         try:
-            doc = tomllib.loads(mfile.read_text(encoding="utf-8"))
+            doc = tomllib.loads(Path(mfile).read_text(encoding="utf-8"))
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{mfile.name} is not valid TOML ({exc})") from None
-        table = doc.get("ground", doc)
-        return medium_from_mapping(table, frequency, where=mfile.stem)
+            raise ValueError(f"{Path(mfile).name} is not valid TOML ({exc})") from None
+        return dict(doc.get("ground", doc))
     loss = {k: v for k, v in (("tan_delta", td), ("sigma", sg)) if v is not None}
     if layers is not None:
         if eps is not None or zs is not None:
@@ -182,7 +186,7 @@ def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
                 raise click.BadParameter(f"each layer is TOP:EPS (m, permittivity), got "
                                          f"{part!r}", param_hint="--layers")
             items.append({"top": top_m, "eps": parse_complex(value, "--layers eps"), **loss})
-        return medium_from_mapping({"layer": items}, frequency, where="--layers")
+        return {"layer": items}
     if eps is None and zs is None:
         if loss:
             raise click.BadParameter("--tan-delta/--sigma need a ground: --eps and --z-surface",
@@ -191,8 +195,19 @@ def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
     if eps is None or zs is None:
         raise click.BadParameter("give both --eps and --z-surface, or neither",
                                  param_hint="--eps/--z-surface")
-    return medium_from_mapping({"surface": zs, "eps": parse_complex(eps, "--eps"), **loss},
-                               frequency, where="ground")
+    return {"surface": zs, "eps": parse_complex(eps, "--eps"), **loss}
+
+
+def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
+    """The Medium the flags describe (None: free space)."""
+    from ...model.scene_file import medium_from_mapping
+
+    table = ground_table_from_options(spec)
+    if table is None:
+        return None
+    where = (Path(spec["medium_file"]).stem if spec["medium_file"] is not None
+             else "--layers" if spec["layers"] is not None else "ground")
+    return medium_from_mapping(table, frequency, where=where)
 
 
 def depth_ranges(text: str, name: str = "--z") -> float | np.ndarray:

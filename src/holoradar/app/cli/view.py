@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import tomllib
+import math
 from pathlib import Path
 from typing import Any
 
@@ -35,28 +35,10 @@ def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[s
     click.BadParameter, ValueError
         A ground the medium options refuse, with their message.
     """
-    from ...model.scene_file import medium_from_mapping
-    from .common import medium_from_options
+    from .common import ground_table_from_options, medium_from_options
 
-    if spec["medium_file"] is not None:
-        medium_from_options(spec, frequency or 1e10)  # the same checks and messages
-        doc = tomllib.loads(Path(spec["medium_file"]).read_text(encoding="utf-8"))
-        return dict(doc.get("ground", doc))
-    medium = medium_from_options(spec, frequency or 1e10)
-    if medium is None:
-        return None
-    if spec["layers"] is not None:
-        layers = []
-        for part in spec["layers"].split(","):
-            top, _, value = part.partition(":")
-            layers.append({"top": float(top), "eps": value.strip(),
-                           **{k: spec[k] for k in ("tan_delta", "sigma") if spec[k] is not None}})
-        table: dict[str, Any] = {"layer": layers}
-    else:
-        table = {"surface": float(spec["z_surface"]), "eps": str(spec["eps"]).strip(),
-                 **{k: spec[k] for k in ("tan_delta", "sigma") if spec[k] is not None}}
-    medium_from_mapping(table, frequency or 1e10, where="ground")
-    return table
+    medium_from_options(spec, frequency or 1e10)  # the same checks and messages as elsewhere
+    return ground_table_from_options(spec)
 
 
 @click.command()
@@ -97,7 +79,7 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
     the settings (TOML; `holoradar render` reproduces the image from it).
     Serves until Ctrl+C.
     """
-    from ..view.server import make_server, open_in_browser, url_of
+    from ..view.server import open_in_browser, url_of
     from ..view.session import ViewSession
     from ..view.settings import read_settings
 
@@ -112,7 +94,14 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
     session = ViewSession(paths, layout=layout, check=check)
     freq = float(np.mean(session.frequencies)) if session.frequencies.size else None
     ground = ground_from_options(medium_spec, freq)
-    ground_file = ground if ground is not None and "layer" in ground else None
+    if session.kind != "holograms":
+        # An image or a survey is shown as it is: the imaging's knobs do not apply.
+        given = [n for n, v in (("the ground flags", ground is not None),
+                                ("--glare", glare not in (None, "off"))) if v]
+        if given:
+            what = "an image" if session.kind == "image" else "a survey"
+            raise click.BadParameter(f"{' and '.join(given)} apply to holograms; "
+                                     f"{paths[0].name} holds {what}", param_hint="FILES")
     if base is not None:
         s = base.replace(files=tuple(str(p) for p in paths))
         if ground is not None:
@@ -122,6 +111,9 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
     if glare is not None:
         s = s.replace(glare=glare)
     if depth is not None:
+        if not math.isfinite(depth):
+            raise click.BadParameter(f"expected a depth in metres, got {depth}",
+                                     param_hint="--depth")
         s = s.replace(depth=depth)
         if s.sweep is not None and not s.sweep[0] <= depth <= s.sweep[1]:
             # the slider spans the sweep: widen it to the depth asked for
@@ -131,8 +123,7 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
 
         s = s.replace(depth=float(peak_position(session.sweep(s))[2] - session.surface(s)))
     session.medium(s)  # a bad ground fails here, before the server starts
-    server = make_server(session, s, host=host, port=port, export_dir=export_dir,
-                         ground_file=ground_file)
+    server = _serve(session, s, host, port, export_dir)
     url = url_of(server, host)
     report.done({"url": url, "files": [str(p) for p in paths]},
                 [f"holoradar view: serving {url} (Ctrl+C to stop)"])
@@ -147,6 +138,29 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         pass
     finally:
         server.stop()
+
+
+def _serve(session: Any, s: Any, host: str, port: int, export_dir: Path | None) -> Any:
+    """The started server, or a click error naming ``--host`` or ``--port``."""
+    import errno
+    import socket
+
+    from ..view.server import make_server
+
+    try:
+        return make_server(session, s, host=host, port=port, export_dir=export_dir)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc).removeprefix("host: "), param_hint="--host") from None
+    except OSError as exc:
+        if isinstance(exc, socket.gaierror) or exc.errno == errno.EADDRNOTAVAIL:
+            raise click.BadParameter(f"cannot serve on {host!r}: {exc.strerror or exc}",
+                                     param_hint="--host") from None
+        if port and exc.errno in (errno.EADDRINUSE, errno.EACCES):
+            raise click.BadParameter(f"cannot serve on port {port}: {exc.strerror}"
+                                     + (" (choose another, or leave --port out for a free one)"
+                                        if exc.errno == errno.EADDRINUSE else ""),
+                                     param_hint="--port") from None
+        raise
 
 
 @click.command()
@@ -192,10 +206,16 @@ def render(settings_file: Path, out: Path, png: bool, force: bool, layout: str |
     ref = float(np.abs(img.data).max()) or 1.0
     pk = peak_of(img, ref)
     fig_bytes = to_png(look_figure(session, s)) if png else None
+    existed = out.exists()
     save(img, out, overwrite=force, history=look_history(s))
     files = [str(out)]
     if fig_bytes is not None:
-        write_atomic(out.with_suffix(".png"), fig_bytes)
+        try:
+            write_atomic(out.with_suffix(".png"), fig_bytes)
+        except BaseException:
+            if not existed:  # a new look is written whole or not at all
+                out.unlink(missing_ok=True)
+            raise
         files.append(str(out.with_suffix(".png")))
     surf = session.surface(s) if s.plane == "image" else 0.0
     report.done({"peak_m": [pk.x, pk.y, pk.z], "depth_m": pk.z - surf, "out": str(out),

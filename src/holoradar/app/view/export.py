@@ -28,7 +28,9 @@ def _write_new(folder: Path, stem: str, suffix: str, write: Callable[[Path], Any
     """``write(tmp)`` to a hidden temporary file in ``folder``, then give it the first free
     name of ``stem{suffix}``, ``stem_2{suffix}``, ...: a hard link is refused by the
     system when the name exists, so no file is ever replaced, even one that appears
-    meanwhile. Returns the path written."""
+    meanwhile (where there are no hard links, the name is first claimed by creating
+    it exclusively, empty, and the finished file renamed onto it). Returns the path
+    written."""
     fd, tmp = tempfile.mkstemp(prefix=f".{stem}.", suffix=f".tmp{suffix}", dir=folder)
     os.close(fd)
     tmp_path = Path(tmp)
@@ -42,16 +44,14 @@ def _write_new(folder: Path, stem: str, suffix: str, write: Callable[[Path], Any
                 return p
             except FileExistsError:
                 i += 1
-            except OSError:  # no hard links here (FAT, some network shares): copy, exclusively
-                try:
-                    fh = open(p, "xb")  # closed below; removed if unfinished
+            except OSError:  # no hard links here (FAT, some network shares)
+                try:  # claim the name, then rename the whole file onto it
+                    open(p, "xb").close()
                 except FileExistsError:
                     i += 1
                     continue
                 try:
-                    with fh:
-                        fh.write(tmp_path.read_bytes())
-                    os.chmod(p, tmp_path.stat().st_mode & 0o777)
+                    os.replace(tmp_path, p)
                 except BaseException:
                     p.unlink(missing_ok=True)
                     raise

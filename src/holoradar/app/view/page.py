@@ -61,7 +61,8 @@ class ViewerPage:
     export_dir : Path
         Where the export buttons write (never replacing a file).
     ground_file : Mapping, optional
-        A layered ground read from a TOML medium file, offered as a choice.
+        A layered ground offered as a choice; default the layered ground of
+        ``settings`` (from a medium file, ``--layers`` or a saved look).
     """
 
     def __init__(self, doc: Any, session: ViewSession, settings: ViewSettings,
@@ -70,14 +71,13 @@ class ViewerPage:
         self.session = session
         self.s = settings
         self.export_dir = export_dir
-        self.ground_file = ground_file
+        layered = settings.ground is not None and "layer" in settings.ground
+        self.ground_file = ground_file or (dict(settings.ground) if layered else None)
         self.ref = 1.0
         self.volume = None
-        self.plane = None
         self.points: list[tuple[float, float, float]] = []
         self.pending_plane = False
         self.pending_full = False
-        self.frames = 0
         self._syncing = False  # True while the page itself moves its widgets
         self._full_ok = True  # the last sweep (sections, colour scale) succeeded
         self._build()
@@ -150,7 +150,7 @@ class ViewerPage:
             scale="db" if self.scale.active == 0 else "linear"))
         self.db_range = Spinner(title="dB range", value=s.db_range, step=5, low=1, high=200,
                                 width=90, name="db_range")
-        self.db_range.on_change("value", lambda _a, _o, n: self._set(db_range=float(n)))
+        self.db_range.on_change("value", lambda _a, _o, n: self._set_db_range(n))
         self.which = RadioButtonGroup(labels=["image plane", "mirror-source plane"],
                                       active=0 if s.plane == "image" else 1, name="plane")
         self.which.on_change("active", lambda _a, _o, n: self._set(
@@ -250,7 +250,7 @@ class ViewerPage:
         self.holo_view = Select(title="hologram of view", options=[(str(i), n) for i, n in
                                                                    enumerate(names)],
                                 value="0", name="holo_view", width=200)
-        self.holo_view.on_change("value", lambda _a, _o, _n: self._holo())
+        self.holo_view.on_change("value", lambda _a, _o, _n: self._guard(self._holo))
         self.h_amp = ColumnDataSource(data=dict(self.xz_src.data))
         self.h_phase = ColumnDataSource(data=dict(self.xz_src.data))
         self.h_spec = ColumnDataSource(data=dict(self.xz_src.data))
@@ -266,9 +266,14 @@ class ViewerPage:
             f.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src, color_mapper=m)
             f.add_layout(ColorBar(color_mapper=m, width=8), "right")
             self.hfigs.append(f)
+        # The waves that travel: |k_t| <= k, or 2k for a monostatic (transceiver) record,
+        # whose phase is that of the path there and back.
         t = np.linspace(0, 2 * np.pi, 181)
-        self.hfigs[2].line(np.cos(t), np.sin(t), color="white", line_dash="dashed")
-        self.hfigs[2].add_layout(Label(x=0.55, y=0.8, text="|k_t| = k", text_color="white",
+        kmax = 2.0 if holo and S.views[0].monostatic else 1.0
+        self.hfigs[2].line(kmax * np.cos(t), kmax * np.sin(t), color="white",
+                           line_dash="dashed")
+        self.hfigs[2].add_layout(Label(x=0.55 * kmax, y=0.8 * kmax, text_color="white",
+                                       text="|k_t| = 2k" if kmax == 2 else "|k_t| = k",
                                        text_font_size="9pt"))
         # the cursor readout: x, y from the pointer, the value from the shown plane
         self.fig.js_on_event("mousemove", CustomJS(args={"src": self.src, "div": self.readout,
@@ -328,7 +333,7 @@ class ViewerPage:
             what = (f"{len(S.views)} view(s), {h.x.size} x {h.y.size} elements, pitch "
                     f"{h.pitch[0] * CM:.3g} cm, {fs}"
                     + (", tilted array" if S.tilted else ""))
-        return f"<b>{', '.join(p.name for p in S.paths)}</b><br>{what}"
+        return f"<b>{html.escape(', '.join(p.name for p in S.paths))}</b><br>{what}"
 
     # ------------------------------------------------------------- settings
     def _set(self, **changes: Any) -> None:
@@ -342,6 +347,12 @@ class ViewerPage:
             self._recolour()
         else:
             self._schedule_full()
+
+    def _set_db_range(self, value: float | None) -> None:
+        if value is None:
+            self._error("dB range: give a number of dB (1 to 200)")
+            return
+        self._set(db_range=float(value))
 
     def _set_views(self, active: list[int]) -> None:
         if not active:
@@ -413,15 +424,17 @@ class ViewerPage:
             self.pending_plane = True
             self.doc.add_next_tick_callback(self._plane)
 
-    def _guard(self, work: Any) -> bool:
+    def _guard(self, work: Any, what: str = "") -> bool:
+        """Run ``work()``; an error is shown on the page (prefixed by ``what``), never lost
+        in a callback."""
         try:
             work()
-        except ValueError as exc:
-            self._error(str(exc))
+        except (ValueError, OSError) as exc:
+            self._error(f"{what}{exc}")
             return False
         except Exception as exc:  # a bug must show, not freeze the page
             traceback.print_exc()
-            self._error(f"internal error: {type(exc).__name__}: {exc}")
+            self._error(f"{what}internal error: {type(exc).__name__}: {exc}")
             return False
         return True
 
@@ -430,9 +443,8 @@ class ViewerPage:
         self.pending_full = False
         self._full_ok = self._guard(self._compute_full)
         if self._full_ok:
-            heard = sorted(self.session.heard)
             self.status.text = "".join(f'<div style="color:#a60">note: {html.escape(w)}</div>'
-                                       for w in heard)
+                                       for w in self.session.notes(self.s))
         self._plane()
 
     def _compute_full(self) -> None:
@@ -459,7 +471,6 @@ class ViewerPage:
     def _compute_plane(self) -> None:
         S, s = self.session, self.s
         img = S.image(s)
-        self.plane = img
         amp = np.abs(img.data)
         x0, w = _edges(img.x)
         y0, h = _edges(img.y)
@@ -485,7 +496,6 @@ class ViewerPage:
         self.src.data = data
         if s.scale == "linear":
             self.plan.glyph.image = "lin"  # after the data that has it
-        self.frames += 1
 
     def _recolour_mapper(self) -> None:
         s = self.s
@@ -609,14 +619,13 @@ class ViewerPage:
     def _export(self, what: str) -> None:
         from .export import export_netcdf, export_png, export_settings
 
-        try:
+        def work() -> None:
             if what == "PNG":
                 p = export_png(self.session, self.s, self.export_dir)
             elif what == "NetCDF":
                 p = export_netcdf(self.session, self.s, self.export_dir)
             else:
                 p = export_settings(self.s, self.export_dir)
-        except (ValueError, OSError) as exc:
-            self._error(f"export {what}: {exc}")
-            return
-        self.exported.text = f"wrote {p}"
+            self.exported.text = f"wrote {html.escape(str(p))}"
+
+        self._guard(work, f"export {what}: ")

@@ -10,6 +10,7 @@ path from a request, so only the files given on the command line are read.
 
 from __future__ import annotations
 
+import errno
 import ipaddress
 import warnings
 import webbrowser
@@ -61,6 +62,13 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
     bokeh.server.server.Server
         Started; run ``server.io_loop.start()`` to serve (blocks), ``server.stop()``
         to end.
+
+    Raises
+    ------
+    ValueError
+        An IPv6 address other than ``::`` as ``host``.
+    OSError
+        The address cannot be bound (a name that does not resolve, a port in use).
     """
     from bokeh.application import Application
     from bokeh.application.handlers.function import FunctionHandler
@@ -68,6 +76,11 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
 
     from .page import ViewerPage
 
+    if ":" in host and host != "::":
+        # Bokeh checks the page's websocket origin as name:port, which an IPv6 address
+        # cannot be written in.
+        raise ValueError(f"host: an IPv6 address ({host}) cannot be served: give 127.0.0.1, "
+                         "localhost, 0.0.0.0, :: or a host name")
     if not is_loopback(host):
         warnings.warn(f"serving on {host}, not the loopback: anyone who can reach this "
                       "machine can see the data and use the page", UserWarning, stacklevel=2)
@@ -77,11 +90,18 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
         ViewerPage(doc, session, settings, folder, ground_file)
 
     app = Application(FunctionHandler(make_doc))
-    if not port:
-        port = _free_port(host)
-    origins = [f"{_bracket(n)}:{port}" for n in _names_of(host)]
-    server = Server({"/": app}, address=host, port=port, allow_websocket_origin=origins,
-                    num_procs=1)
+    # A free port is found, then bound by the server: another program may take it in
+    # between, so a port chosen here is chosen again when that happens.
+    for attempt in range(5):
+        at = port or _free_port(host)
+        origins = [f"{n}:{at}" for n in _names_of(host)]
+        try:
+            server = Server({"/": app}, address=host, port=at,
+                            allow_websocket_origin=origins, num_procs=1)
+            break
+        except OSError as exc:
+            if port or exc.errno != errno.EADDRINUSE or attempt == 4:
+                raise
     server.start()
     return server
 
@@ -94,10 +114,6 @@ def _free_port(host: str) -> int:
     with socket.socket(family, socket.SOCK_STREAM) as sock:
         sock.bind((host, 0))
         return int(sock.getsockname()[1])
-
-
-def _bracket(name: str) -> str:
-    return f"[{name}]" if ":" in name else name
 
 
 def _names_of(host: str) -> list[str]:
@@ -113,10 +129,12 @@ def _names_of(host: str) -> list[str]:
         me = socket.gethostname()
         names += [me, socket.getfqdn(), "localhost", "127.0.0.1"]
         try:
-            names += sorted({str(a[4][0]) for a in socket.getaddrinfo(me, None)})
+            # IPv4 only: an IPv6 address cannot be an origin (see make_server)
+            names += sorted({str(a[4][0]) for a in socket.getaddrinfo(me, None,
+                                                                      socket.AF_INET)})
         except OSError:  # a machine without a resolvable name: its name must do
             pass
-    return list(dict.fromkeys(n for n in names if n))
+    return list(dict.fromkeys(n for n in names if n and ":" not in n))
 
 
 def url_of(server: Any, host: str) -> str:
@@ -124,7 +142,7 @@ def url_of(server: Any, host: str) -> str:
     import socket
 
     name = socket.gethostname() if host in ("0.0.0.0", "::", "") else host
-    return f"http://{_bracket(name)}:{server.port}/"
+    return f"http://{name}:{server.port}/"
 
 
 def open_in_browser(url: str, opener: Callable[[str], Any] = webbrowser.open) -> None:

@@ -175,7 +175,7 @@ class ViewSession:
         self._caches()
 
     def _caches(self) -> None:
-        self.heard: set[str] = set()  # warnings of the imaging, for the page to show
+        # Images are cached with what the imaging warned about while making them.
         self._clean = _Cache(8)
         self._planes = _Cache(256)
         self._sweeps = _Cache(4)
@@ -312,8 +312,10 @@ class ViewSession:
         return out, notes
 
     # ----------------------------------------------------------------- images
-    def _form(self, s: ViewSettings, z: Any) -> Image:
-        """The image of the selected views at range(s) ``z``."""
+    def _form(self, s: ViewSettings, z: Any) -> tuple[Image, tuple[str, ...]]:
+        """The image of the selected views at range(s) ``z``, and what the imaging warned
+        about (an assumed illumination, say; the aliasing of the array's pitch is known
+        and said in the page's info)."""
         from ...imaging.migrate import migrate
         from ...imaging.synthesis import synthesize
 
@@ -326,19 +328,16 @@ class ViewSession:
             kw["fov"] = s.fov
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
-            try:
-                if len(use) == 1:
-                    return migrate(use[0], z, medium=medium, combine=combine, **kw)
-                if combine == "incoherent" and use[0].is_wideband:
-                    raise ValueError("views.frequency: the incoherent sum of frequencies is "
-                                     "for one view; several views add their coherent images "
-                                     "(choose 'coherent' or one frequency)")
-                return synthesize(use, z, medium=medium, mode=s.mode, **kw)
-            finally:
-                # What the imaging warned about (an assumed illumination, say) is kept for
-                # the page; aliasing of the array's pitch is known and said in its info.
-                self.heard |= {str(w.message) for w in said
-                               if not issubclass(w.category, AliasingWarning)}
+            if len(use) == 1:
+                img = migrate(use[0], z, medium=medium, combine=combine, **kw)
+            elif combine == "incoherent" and use[0].is_wideband:
+                raise ValueError("views.frequency: the incoherent sum of frequencies is "
+                                 "for one view; several views add their coherent images "
+                                 "(choose 'coherent' or one frequency)")
+            else:
+                img = synthesize(use, z, medium=medium, mode=s.mode, **kw)
+        return img, tuple(sorted({str(w.message) for w in said
+                                  if not issubclass(w.category, AliasingWarning)}))
 
     def _key(self, s: ViewSettings) -> tuple[Any, ...]:
         return (self._glare_key(s), s.views, s.mode, s.upsample, s.fov, s.frame)
@@ -360,7 +359,7 @@ class ViewSession:
         if s.plane == "mirror":
             return self.mirror_plane(s)
         z = self.surface(s) + d
-        return self._planes.get((self._key(s), round(z, 12)), lambda: self._form(s, z))
+        return self._planes.get((self._key(s), round(z, 12)), lambda: self._form(s, z))[0]
 
     def sweep(self, s: ViewSettings) -> Image:
         """The volume behind the sections and the colour scale: ``s.planes`` planes over
@@ -375,9 +374,17 @@ class ViewSession:
                              self.survey_z.copy(), p0.frequency, p0.method)
 
             return self._sweeps.get(("mosaic",), stack)
+        return self._swept(s)[0]
+
+    def _swept(self, s: ViewSettings) -> tuple[Image, tuple[str, ...]]:
         a, b = s.sweep if s.sweep is not None else (0.0, 0.25)
         zs = self.surface(s) + np.linspace(a, b, s.planes)
         return self._sweeps.get((self._key(s), a, b, s.planes), lambda: self._form(s, zs))
+
+    def notes(self, s: ViewSettings) -> tuple[str, ...]:
+        """What the imaging warned about for ``s`` (its depth sweep's warnings: the same
+        views, ground and settings as each plane); empty for an image or a survey."""
+        return self._swept(s)[1] if self.kind == "holograms" else ()
 
     def mirror_source(self, s: ViewSettings) -> tuple[int, float]:
         """The view whose glare is shown (the first selected) and its mirror plane's range
@@ -402,12 +409,12 @@ class ViewSession:
 
         i, zm = self.mirror_source(s)
         views, _ = self.cleaned(s)
-        kw = {"fov": s.fov} if s.frame == "aperture" else {}
 
         def make() -> Image:
+            # in the array's own frame: mirror_source took an array facing the ground
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                return migrate(views[i], zm, upsample=s.upsample, **kw)
+                return migrate(views[i], zm, upsample=s.upsample, fov=s.fov)
 
         return self._planes.get(("mirror", self._glare_key(s), i, s.upsample, s.fov), make)
 

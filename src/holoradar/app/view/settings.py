@@ -80,6 +80,11 @@ class ViewSettings:
     ground: Mapping[str, Any] | None = field(default=None)
 
     def __post_init__(self) -> None:
+        # Lists (as TOML and JSON give them) are taken as the tuples the fields hold.
+        for name in ("files", "sweep", "views", "section"):
+            v = getattr(self, name)
+            if isinstance(v, list):
+                object.__setattr__(self, name, tuple(v))
         _check(self)
 
     def replace(self, **changes: Any) -> ViewSettings:
@@ -116,6 +121,8 @@ def _check(s: ViewSettings) -> None:
     if s.views is not None and not (isinstance(s.views, tuple) and s.views and all(
             isinstance(i, int) and not isinstance(i, bool) and i >= 0 for i in s.views)):
         _fail("views.use", "a non-empty list of view indices (0, 1, ...)", s.views)
+    if s.views is not None and len(set(s.views)) != len(s.views):
+        _fail("views.use", "view indices each named once", s.views)
     if s.mode not in MODES:
         _fail("views.mode", " or ".join(map(repr, MODES)), s.mode)
     f = s.frequency
@@ -212,7 +219,8 @@ def read_settings(path: str | Path) -> ViewSettings:
 
 def _plain(v: Any) -> Any:
     if isinstance(v, complex):
-        return f"{v.real:g}{v.imag:+g}j"
+        # repr keeps every digit: a saved look reproduces the image bit for bit
+        return f"{v.real!r}{v.imag:+}j"
     if isinstance(v, Mapping):
         return {k: _plain(x) for k, x in v.items() if x is not None}
     if isinstance(v, list | tuple):
