@@ -169,7 +169,7 @@ def ground_table_from_options(spec: dict[str, Any]) -> dict[str, Any] | None:
             doc = tomllib.loads(Path(mfile).read_text(encoding="utf-8"))
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise ValueError(f"{Path(mfile).name} is not valid TOML ({exc})") from None
-        return dict(doc.get("ground", doc))
+        return doc.get("ground", doc)  # its form is checked with the medium it makes
     loss = {k: v for k, v in (("tan_delta", td), ("sigma", sg)) if v is not None}
     if layers is not None:
         if eps is not None or zs is not None:

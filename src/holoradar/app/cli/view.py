@@ -38,7 +38,8 @@ def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[s
     from .common import ground_table_from_options, medium_from_options
 
     medium_from_options(spec, frequency or 1e10)  # the same checks and messages as elsewhere
-    return ground_table_from_options(spec)
+    table = ground_table_from_options(spec)
+    return None if table is None else dict(table)
 
 
 @click.command()
