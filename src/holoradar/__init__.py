@@ -21,14 +21,14 @@ from .data.hologram import C0, Hologram, Image
 from .data.pose import Pose
 from .data.wideband import apply_calibration, conjugate, remove_mean
 from .imaging.autofocus import AutofocusResult, autofocus
-from .imaging.iq import iq_convention
-from .imaging.migrate import IlluminationWarning, migrate
-from .imaging.reflection import (
+from .imaging.glare import (
     FitWarning,
     SuppressionReport,
     estimate_permittivity,
     suppress_surface,
 )
+from .imaging.iq import iq_convention
+from .imaging.migrate import IlluminationWarning, migrate
 from .imaging.stream import StreamImager
 from .imaging.synthesis import align_phases, synthesize
 from .io import load, save

@@ -698,7 +698,7 @@ def _check_glare(glare: Any) -> tuple[float, float]:
 
 
 def _glare_estimate(hologram: Hologram, medium: Medium) -> tuple[Hologram, tuple[float, float]]:
-    from .reflection import suppress_surface
+    from .glare import suppress_surface
 
     if hologram.monostatic or hologram.source is None or hologram.is_wideband:
         raise ValueError("glare=True needs a single-frequency receiver-array hologram with its "

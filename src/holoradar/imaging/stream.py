@@ -6,7 +6,7 @@ not change between frames (transfer functions, incident-phase phasors, the
 direct waves) and then, per frame, does only:
 
 1. fit the glare of every view at once (the complex-source-point beam of
-   :func:`~holoradar.imaging.reflection.suppress_surface` with its direct wave),
+   :func:`~holoradar.imaging.glare.suppress_surface` with its direct wave),
    by one Gauss-Newton step warm-started from the previous frame (a device
    that does not jump between frames needs no more), and subtract it;
 2. one batched FFT of the K holograms, K products with the cached transfer
@@ -28,8 +28,8 @@ from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
 from ..physics.sources import PointSource
+from .glare import FitWarning, _direct_wave, suppress_surface
 from .migrate import _zero_pad_spectrum
-from .reflection import FitWarning, _direct_wave, suppress_surface
 from .synthesis import _check_views
 
 __all__ = ["StreamImager"]

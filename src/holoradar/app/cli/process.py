@@ -87,7 +87,7 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
     The ground (--eps/--z-surface, --layers or --medium) sets the mirror plane;
     its permittivity is the fit's starting value and is estimated from the glare.
     """
-    from ...imaging.reflection import suppress_surface
+    from ...imaging.glare import suppress_surface
     from ...io import save
     from ...io.output import check_output
 

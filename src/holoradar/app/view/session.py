@@ -269,7 +269,7 @@ class ViewSession:
         return h
 
     def _make_clean(self, s: ViewSettings) -> tuple[list[Hologram], list[GlareSummary]]:
-        from ...imaging.reflection import suppress_surface
+        from ...imaging.glare import suppress_surface
 
         views = [self._at_frequency(h, s) for h in self.views]
         if s.glare == "off":

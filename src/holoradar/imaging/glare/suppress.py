@@ -1,56 +1,31 @@
-"""Suppression of the surface glare (paper section 3.3, docs/glare.md).
+"""Removing the surface glare from one view: :func:`suppress_surface`.
 
-The radiator's specular reflection from a flat ground is the wave of its mirror
-image at range ``z_m = 2*z0 - z_s``: migrated through AIR it focuses there into a
-compact bright spot, while buried objects stay defocused. Methods:
-
-``"cut"``
-    Migrate to z_m (the whole padded grid: the spot may lie beside the array),
-    mask the spot with a hard disk or a raised-cosine taper, propagate the masked
-    part back to the aperture and subtract it (paper's "biting off"). The sharp
-    edge leaves parasitic ripples (paper Fig. 14c).
-``"gaussian"``
-    Fit a Gaussian beam to the glare and subtract it. The beam is the exact
-    complex-source-point beam ``exp(i*k*Rc)/Rc`` with
-    ``Rc = sqrt((x - xc)^2 + (y - yc)^2 + (zc - i*b)^2)``: waist
-    ``w0 = sqrt(2*b/k)`` at range zc, a spherical wave from the mirror image when
-    b -> 0. It is evaluated on the array's elements, i.e. as seen through the
-    finite rectangular aperture, and fitted there (centre, range, waist, complex
-    amplitude) by least squares; subtracting it from the hologram equals
-    subtracting its aperture-limited image at z_m and propagating back.
-``"image_source"``
-    The physical model: the exact reflected field of the source from the layered
-    ground (Sommerfeld integral with the angle-dependent reflection coefficient,
-    :func:`~holoradar.physics.green.layered_green`), with the ground's
-    permittivity and the source's complex amplitude fitted. It yields the
-    permittivity of the top layer with its uncertainty.
-``"background"``
-    Subtract a measured or simulated hologram of the empty scene.
-
-The radiator's direct wave into the aperture (its own spherical wave times its
-pattern, known in shape) is fitted jointly, with a free complex amplitude, and
-removed too (``direct=True``). It would focus at the radiator's own range, which
-is usually the aperture plane or behind it, where no image can be formed.
+Holds the public entry point with its report (:class:`SuppressionReport`) and
+warning (:class:`FitWarning`), the ``"cut"`` and ``"background"`` methods, the
+mirror-plane image and spot search (``_mirror_*``, ``_grid_coords``,
+``_find_spot``) and the argument checks (``_check``); the model fits live in
+:mod:`.beams` and :mod:`.image_source`.
 """
 
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
-from scipy.optimize import brentq, least_squares
 
-from ..analysis.theory import lateral_resolution
-from ..data.hologram import Hologram
-from ..physics.medium import Medium
-from ..physics.propagation import AngularSpectrum
-from ..physics.sources import GaussianBeam, PointSource
+from ...analysis.theory import lateral_resolution
+from ...data.hologram import Hologram
+from ...physics.medium import Medium
+from ...physics.propagation import AngularSpectrum
+from ...physics.sources import GaussianBeam, PointSource
+from ._common import _direct_wave, _joint_direct
+from .beams import _eps_from_gaussian, _fit_gaussian
+from .image_source import _fit_image_source
 
-__all__ = ["FitWarning", "SuppressionReport", "estimate_permittivity", "suppress_surface"]
+__all__ = ["FitWarning", "SuppressionReport", "suppress_surface"]
 
 Method = Literal["gaussian", "cut", "image_source", "background"]
 
@@ -195,7 +170,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         is the direct wave. For a Gaussian beam ``"gaussian"`` reports no eps (the
         beam's own amplitude is not a point source's): use ``"image_source"``.
     method : {"gaussian", "cut", "image_source", "background"}
-        See the module docstring.
+        See :mod:`holoradar.imaging.glare`.
     background : Hologram, optional
         The empty-scene hologram, for ``"background"``.
     direct : bool
@@ -403,278 +378,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                                                                                **report_kw)
 
 
-def _direct_wave(src: PointSource | GaussianBeam, k: float, pts: np.ndarray) -> np.ndarray:
-    """The radiator's own wave at air points, for unit amplitude: ``exp(ikR)/R`` times its
-    pattern along the straight ray, or the incoming Gaussian beam (the shape the
-    direct-wave fit scales)."""
-    return replace(src, amplitude=1.0).field(k, Medium.free_space(), pts)
-
-
-def _joint_direct(h: np.ndarray, glare: np.ndarray, D: np.ndarray | None
-                  ) -> tuple[complex | None, np.ndarray, np.ndarray]:
-    """Fit the direct wave's amplitude to what the glare leaves."""
-    if D is None:
-        return None, glare, np.zeros_like(h)
-    rest = h - glare
-    d = complex(np.vdot(D, rest) / np.vdot(D, D))
-    return d, glare, d * D
-
-
-def _linear_fit(h: np.ndarray, basis: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares complex coefficients of ``basis`` columns; returns (coef, model)."""
-    B = np.stack(basis, axis=1)
-    coef, *_ = np.linalg.lstsq(B, h, rcond=None)
-    return coef, B @ coef
-
-
-def _csp_beam(k: float, pts: np.ndarray, x: float, y: float, z: float, b: float,
-              u: np.ndarray | None = None) -> np.ndarray:
-    """Complex-source-point beam exp(i k Rc)/Rc seen at ``pts``: waist at (x, y, z),
-    travelling along the unit vector ``u`` (default -z, towards the aperture).
-
-    The source sits at the complex point ``c + i*b*u``: ``Rc = |r - c - i*b*u|`` is, on
-    the axis, the distance along it less ``i*b``, a Gaussian beam of waist
-    ``sqrt(2*b/k)``.
-    """
-    ux, uy, uz = (0.0, 0.0, -1.0) if u is None else (float(u[0]), float(u[1]), float(u[2]))
-    Rc = np.sqrt((pts[:, 0] - x - 1j * b * ux) ** 2 + (pts[:, 1] - y - 1j * b * uy) ** 2
-                 + (pts[:, 2] - z - 1j * b * uz) ** 2)
-    Rc = np.where(Rc.real < 0, -Rc, Rc)
-    return np.exp(1j * k * Rc) / Rc
-
-
-def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None, xs: float,
-                  ys: float, z_m: float, cell: float, initial: dict[str, Any] | None,
-                  transform: Callable[[np.ndarray], np.ndarray] | None = None,
-                  u: np.ndarray | None = None, b0: float | None = None):
-    """Fit ``a*beam + d*D`` to the data, in the domain ``transform`` maps them to.
-
-    ``transform`` is the windowed image of the mirror plane (the paper's choice:
-    there the glare is a compact spot and buried objects are defocused); ``None``
-    fits on the elements themselves.
-    """
-    scale = cell
-    # The spot lies in the mirror plane by construction: its range is not fitted (a
-    # free range lets the beam swallow a buried reflector's own, deeper, focus).
-    start_b = 0.01 * cell if b0 is None else b0
-    x0 = np.array([xs, ys, start_b]) if not initial else np.array(
-        [initial["x"], initial["y"], max(initial["b"], 1e-6)])
-    T = transform if transform is not None else (lambda v: v)
-    th = T(h).ravel()
-    tD = None if D is None else T(D).ravel()
-
-    def parts(theta: np.ndarray):
-        G = _csp_beam(k, pts, theta[0], theta[1], z_m, theta[2], u)
-        # exp(ik Rc)/Rc grows as exp(k b) with the waist (1e33 for a 6 cm beam at
-        # 10 GHz): scale it to unit norm so that the joint fit with the direct wave is
-        # well conditioned, and scale its coefficient back.
-        norm = float(np.linalg.norm(G)) or 1.0
-        tG = T(G / norm).ravel()
-        basis = [tG] if tD is None else [tG, tD]
-        coef, model = _linear_fit(th, basis)
-        coef = coef.copy()
-        coef[0] /= norm
-        return coef, model, G
-
-    def resid(u: np.ndarray) -> np.ndarray:
-        theta = x0 + u * scale
-        theta[2] = abs(theta[2])
-        _, model, _ = parts(theta)
-        r = th - model
-        return np.concatenate([r.real, r.imag])
-
-    # The mirror image of a horn is a spot no wider than the horn's mouth: its waist is
-    # bounded by one wavelength. A wider beam would swallow the defocused, but nearby
-    # in range, specular return of a buried planar reflector.
-    # A Gaussian-beam radiator's reflected beam has the radiator's own waist: allow it
-    # half to twice that (the stack's reflection reshapes the spectrum a little).
-    b_max = k * (2 * np.pi / k) ** 2 / 2 if b0 is None else 4 * b0
-    lo = np.array([-3.0, -3.0, (-x0[2] if b0 is None else 0.25 * b0 - x0[2]) / scale])
-    hi = np.array([3.0, 3.0, (b_max - x0[2]) / scale])
-    sol = least_squares(resid, np.clip(np.zeros(3), lo, hi), bounds=(lo, hi), xtol=1e-10,
-                        ftol=1e-12, max_nfev=400)
-    theta = x0 + sol.x * scale
-    theta[2] = abs(theta[2])
-    coef, _, G = parts(theta)
-    a = complex(coef[0])
-    dcoef = None if D is None else complex(coef[1])
-    explained = 1 - np.sum(sol.fun**2) / max(np.sum(np.abs(th) ** 2), 1e-300)
-    fit = {"x": float(theta[0]), "y": float(theta[1]), "z": float(z_m),
-           "b": float(theta[2]), "a": a, "converged": bool(sol.success and explained > 0.5)}
-    return a * G, (np.zeros_like(h) if D is None else dcoef * D), dcoef, fit
-
-
-def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
-                  ) -> tuple[float, float]:
-    """1-sigma of least-squares parameters when the residual is spatially correlated.
-
-    What the glare model leaves is mostly the object's own field and the noise:
-    smooth over the aperture, not white, so ``s^2 (J^T J)^-1`` would be far too
-    optimistic. The sandwich (Huber-White / Newey-West) estimator
-    ``B^-1 M B^-1``, ``B = Re(J^H J)``, ``M = Cov(Re(J^H r)) = Re(J^H S J)/2`` for a
-    circular complex residual, uses the residual's covariance S, taken stationary
-    and estimated from its autocorrelation over the aperture with a Bartlett lag
-    window reaching half the aperture (Newey & West 1987): the raw all-lag
-    estimate would give ``J^H S J ~ |J^H r|^2``, which vanishes at the fit.
-    """
-    n = fun.size // 2
-    r = (fun[:n] + 1j * fun[n:]).reshape(shape)
-    J = (jac[:n] + 1j * jac[n:]).reshape((*shape, -1))
-    ny, nx = shape
-    s = (2 * ny, 2 * nx)
-    acf = sfft.ifft2(np.abs(sfft.fft2(r, s=s)) ** 2) / r.size  # lags in FFT order
-    ly, lx = max(ny / 2, 2.0), max(nx / 2, 2.0)
-    ty = np.abs(sfft.fftfreq(s[0], 1.0 / s[0]))
-    tx = np.abs(sfft.fftfreq(s[1], 1.0 / s[1]))
-    bartlett = np.outer(np.clip(1 - ty / ly, 0, None), np.clip(1 - tx / lx, 0, None))
-    acf_spec = sfft.fft2(acf * bartlett)
-    SJ = sfft.ifft2(sfft.fft2(J, s=s, axes=(0, 1)) * acf_spec[..., None], axes=(0, 1))
-    SJ = SJ[:ny, :nx]
-    Jf = J.reshape(-1, J.shape[-1])
-    meat = 0.5 * np.real(Jf.conj().T @ SJ.reshape(-1, J.shape[-1]))
-    bread = np.real(Jf.conj().T @ Jf)
-    try:
-        binv = np.linalg.inv(bread)
-    except np.linalg.LinAlgError:
-        return np.inf, np.inf
-    cov = binv @ meat @ binv
-    return float(np.sqrt(max(cov[0, 0], 0))), float(np.sqrt(max(cov[1, 1], 0)))
-
-
-def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarray,
-                      h: np.ndarray, D: np.ndarray | None, ref: complex | None,
-                      initial: dict[str, Any] | None,
-                      transform: Callable[[np.ndarray], np.ndarray]):
-    """Fit the ground's permittivity from the exact reflected field.
-
-    The glare's strength relative to the radiator's fixes |V|: the radiator's
-    amplitude is either fitted jointly with the direct wave (one complex amplitude
-    for both, since both are its fields: the direct path is the reference) or
-    given (``ref``, a calibration). Fitting it freely for the glare alone would
-    leave eps to the weak angle dependence of V across the aperture.
-    """
-    eps0 = complex(initial["eps"]) if initial and "eps" in initial else complex(medium.eps[1])
-
-    def glare_of(e: np.ndarray) -> np.ndarray:
-        eps = complex(max(e[0], 1e-3), max(e[1], 0.0))
-        m = Medium(medium.z_interfaces, (1.0, eps, *medium.eps[2:]), medium.polarization)
-        return replace(src, amplitude=1.0).reflected(k, m, pts)
-
-    th = transform(h)
-    tD = None if D is None else transform(D)
-
-    def parts(e: np.ndarray) -> tuple[complex, np.ndarray, np.ndarray]:
-        G = glare_of(e)
-        tG = transform(G)
-        if tD is not None and ref is None:
-            basis = tD + tG
-            a = complex(np.vdot(basis, th) / np.vdot(basis, basis))
-        else:
-            a = complex(ref if ref is not None else src.amplitude)
-        return a, G, tG
-
-    def resid(e: np.ndarray) -> np.ndarray:
-        a, _, tG = parts(e)
-        r = (th - a * tG - (0 if tD is None else a * tD)).ravel()
-        return np.concatenate([r.real, r.imag])
-
-    e_start = np.array([eps0.real, max(eps0.imag, 0.0)])
-    sol = least_squares(resid, e_start, x_scale=np.array([0.1, 0.01]) * max(e_start[0], 1.0),
-                        bounds=([1e-3, 0.0], [np.inf, np.inf]), xtol=1e-12, max_nfev=200)
-    a, G, _ = parts(sol.x)
-    std = _sandwich_std(sol.fun, sol.jac, th.shape)
-    eps = complex(sol.x[0], sol.x[1])
-    explained = 1 - np.sum(sol.fun**2) / max(np.sum(np.abs(h) ** 2), 1e-300)
-    fit = {"eps": eps, "eps_std": std, "a": a,
-           "converged": bool(sol.success and explained > 0.5)}
-    dcoef = None if D is None else a
-    return a * G, (np.zeros_like(h) if D is None else a * D), dcoef, fit
-
-
 def _world(pose: Any, x: float, y: float, z: float) -> tuple[float, float, float]:
     """A point of the aperture's frame (x, y along its axes, z along its normal) in
     the world."""
     w = pose.to_world(np.array(x), np.array(y)) + z * pose.normal
     return float(w[0]), float(w[1]), float(w[2])
-
-
-def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
-                       hologram: Hologram, medium: Medium, k: float
-                       ) -> tuple[complex, complex]:
-    """V and eps from the mirror spot's strength.
-
-    The fitted beam ``a*exp(ik Rc)/Rc``, ``Rc ~ s - i*b`` on its axis, is the mirror
-    image's spherical wave ``V * ref * pattern * exp(iks)/s`` for a source of
-    amplitude ``ref``: V = a*exp(k*b) / (ref * pattern), to first order in b/s,
-    the pattern taken along the specular ray from the radiator to the aperture's
-    centre. Its phase is traded against the fitted range of the beam (a
-    millimetre is 0.2 rad), so only |V| is used: for a ground denser than air
-    V = -|V| and n = (1 + |V|)/(1 - |V|), real (loss is not seen this way).
-
-    A posed (tilted or shifted) aperture sees the surface at the specular angle
-    theta of the ray to its centre: eps' then solves ``|r(eps', theta)| = |V|``
-    for the medium's polarization (Fresnel, a half-space), monotonic in eps'.
-    """
-    z0 = medium.z_interfaces[0]
-    centre = hologram.pose.to_world(np.array(np.mean(hologram.x)),
-                                    np.array(np.mean(hologram.y)))
-    # The ray leaves the radiator towards the aperture centre's mirror point, downwards.
-    d = np.array([centre[0] - src.position[0], centre[1] - src.position[1],
-                  2 * z0 - centre[2] - src.position[2]])
-    d /= np.linalg.norm(d)
-    pat = src.pattern(d[None, :])[0] if src.has_pattern else 1.0
-    if pat == 0:
-        return complex(np.nan), complex(np.nan)
-    V = -abs(a * np.exp(k * b) / (ref * pat))
-    if V <= -1:
-        return complex(V), complex(np.nan)
-    if hologram.pose.is_identity:
-        n = (1 - V) / (1 + V)
-        return complex(V), complex(n * n)
-    kappa2 = np.array(k * k * (1 - d[2] ** 2))
-
-    def excess(e: float) -> float:
-        half = Medium((z0,), (1.0, e), medium.polarization)
-        return float(abs(half.reflection(k, kappa2))) - abs(V)
-
-    if excess(1.0 + 1e-9) >= 0 or excess(1e4) <= 0:
-        return complex(V), complex(np.nan)
-    return complex(V), complex(brentq(excess, 1.0 + 1e-9, 1e4, xtol=1e-10))
-
-
-def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None, *,
-                          direct: bool = True) -> tuple[complex, tuple[float, float]]:
-    """Permittivity of the ground's top layer from the glare, with its 1-sigma uncertainty.
-
-    Fits the exact reflected field of the radiator (``method="image_source"``).
-    The glare's strength against the radiator's fixes |V| and hence eps: the
-    radiator's amplitude is the direct wave's, fitted jointly (``direct=True``,
-    the direct-path reference; it must be in the data), or ``source.amplitude``
-    (``direct=False``, a calibration). ``medium`` supplies the geometry and the
-    starting value. The 1-sigma covers receiver noise and diffuse clutter (a
-    sandwich estimate); it does not cover model error (a vector source seen as
-    a scalar one) nor the bias of a single strong buried object, at most
-    ``4 n |V| e / (1 + V)^2`` for an object ``e`` times weaker than the glare.
-
-    Examples
-    --------
-    >>> import holoradar as hr
-    >>> m = hr.Medium.half_space(0.3, 4.0)
-    >>> h = hr.simulate(hr.Scene(m, hr.PointSource((0.0, 0.0, -0.05))),
-    ...                 hr.Aperture.grid(24, 0.015), 9.9e9, include_direct=True)
-    >>> eps, std = estimate_permittivity(h, hr.Medium.half_space(0.3, 3.0))
-    >>> round(eps.real, 2)
-    4.0
-    """
-    src = source if source is not None else getattr(hologram, "source", None)
-    if direct and isinstance(src, PointSource | GaussianBeam):
-        D = _direct_wave(src, hologram.k, hologram.points)
-        h = hologram.data.ravel()
-        share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)
-        if share < 0.01:
-            raise ValueError("direct=True takes the radiator's direct wave as the amplitude "
-                             "reference, but the hologram holds almost none of it (the direct "
-                             "wave explains <1% of it): pass direct=False with a calibrated "
-                             "source amplitude")
-    _, rep = suppress_surface(hologram, medium, source, "image_source", direct=direct)
-    return rep.eps, rep.eps_std

@@ -1,0 +1,107 @@
+"""The image-source fit of the glare (``method="image_source"``).
+
+The exact reflected field of the radiator from the layered ground, with the
+ground's permittivity fitted (:func:`_fit_image_source`), and the sandwich
+estimate of its uncertainty under a spatially correlated residual
+(:func:`_sandwich_std`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import scipy.fft as sfft
+from scipy.optimize import least_squares
+
+from ...physics.medium import Medium
+from ...physics.sources import PointSource
+
+
+def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
+                  ) -> tuple[float, float]:
+    """1-sigma of least-squares parameters when the residual is spatially correlated.
+
+    What the glare model leaves is mostly the object's own field and the noise:
+    smooth over the aperture, not white, so ``s^2 (J^T J)^-1`` would be far too
+    optimistic. The sandwich (Huber-White / Newey-West) estimator
+    ``B^-1 M B^-1``, ``B = Re(J^H J)``, ``M = Cov(Re(J^H r)) = Re(J^H S J)/2`` for a
+    circular complex residual, uses the residual's covariance S, taken stationary
+    and estimated from its autocorrelation over the aperture with a Bartlett lag
+    window reaching half the aperture (Newey & West 1987): the raw all-lag
+    estimate would give ``J^H S J ~ |J^H r|^2``, which vanishes at the fit.
+    """
+    n = fun.size // 2
+    r = (fun[:n] + 1j * fun[n:]).reshape(shape)
+    J = (jac[:n] + 1j * jac[n:]).reshape((*shape, -1))
+    ny, nx = shape
+    s = (2 * ny, 2 * nx)
+    acf = sfft.ifft2(np.abs(sfft.fft2(r, s=s)) ** 2) / r.size  # lags in FFT order
+    ly, lx = max(ny / 2, 2.0), max(nx / 2, 2.0)
+    ty = np.abs(sfft.fftfreq(s[0], 1.0 / s[0]))
+    tx = np.abs(sfft.fftfreq(s[1], 1.0 / s[1]))
+    bartlett = np.outer(np.clip(1 - ty / ly, 0, None), np.clip(1 - tx / lx, 0, None))
+    acf_spec = sfft.fft2(acf * bartlett)
+    SJ = sfft.ifft2(sfft.fft2(J, s=s, axes=(0, 1)) * acf_spec[..., None], axes=(0, 1))
+    SJ = SJ[:ny, :nx]
+    Jf = J.reshape(-1, J.shape[-1])
+    meat = 0.5 * np.real(Jf.conj().T @ SJ.reshape(-1, J.shape[-1]))
+    bread = np.real(Jf.conj().T @ Jf)
+    try:
+        binv = np.linalg.inv(bread)
+    except np.linalg.LinAlgError:
+        return np.inf, np.inf
+    cov = binv @ meat @ binv
+    return float(np.sqrt(max(cov[0, 0], 0))), float(np.sqrt(max(cov[1, 1], 0)))
+
+
+def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarray,
+                      h: np.ndarray, D: np.ndarray | None, ref: complex | None,
+                      initial: dict[str, Any] | None,
+                      transform: Callable[[np.ndarray], np.ndarray]):
+    """Fit the ground's permittivity from the exact reflected field.
+
+    The glare's strength relative to the radiator's fixes |V|: the radiator's
+    amplitude is either fitted jointly with the direct wave (one complex amplitude
+    for both, since both are its fields: the direct path is the reference) or
+    given (``ref``, a calibration). Fitting it freely for the glare alone would
+    leave eps to the weak angle dependence of V across the aperture.
+    """
+    eps0 = complex(initial["eps"]) if initial and "eps" in initial else complex(medium.eps[1])
+
+    def glare_of(e: np.ndarray) -> np.ndarray:
+        eps = complex(max(e[0], 1e-3), max(e[1], 0.0))
+        m = Medium(medium.z_interfaces, (1.0, eps, *medium.eps[2:]), medium.polarization)
+        return replace(src, amplitude=1.0).reflected(k, m, pts)
+
+    th = transform(h)
+    tD = None if D is None else transform(D)
+
+    def parts(e: np.ndarray) -> tuple[complex, np.ndarray, np.ndarray]:
+        G = glare_of(e)
+        tG = transform(G)
+        if tD is not None and ref is None:
+            basis = tD + tG
+            a = complex(np.vdot(basis, th) / np.vdot(basis, basis))
+        else:
+            a = complex(ref if ref is not None else src.amplitude)
+        return a, G, tG
+
+    def resid(e: np.ndarray) -> np.ndarray:
+        a, _, tG = parts(e)
+        r = (th - a * tG - (0 if tD is None else a * tD)).ravel()
+        return np.concatenate([r.real, r.imag])
+
+    e_start = np.array([eps0.real, max(eps0.imag, 0.0)])
+    sol = least_squares(resid, e_start, x_scale=np.array([0.1, 0.01]) * max(e_start[0], 1.0),
+                        bounds=([1e-3, 0.0], [np.inf, np.inf]), xtol=1e-12, max_nfev=200)
+    a, G, _ = parts(sol.x)
+    std = _sandwich_std(sol.fun, sol.jac, th.shape)
+    eps = complex(sol.x[0], sol.x[1])
+    explained = 1 - np.sum(sol.fun**2) / max(np.sum(np.abs(h) ** 2), 1e-300)
+    fit = {"eps": eps, "eps_std": std, "a": a,
+           "converged": bool(sol.success and explained > 0.5)}
+    dcoef = None if D is None else a
+    return a * G, (np.zeros_like(h) if D is None else a * D), dcoef, fit
