@@ -28,6 +28,7 @@ import numpy as np
 from .._validate import as_axis
 from ..data.hologram import Hologram, _frequency_axis
 from ..io.netcdf import source_to_json
+from ._format import read_file, write_file
 from .iq import correct_iq
 from .raw import RawFrames, check_device
 
@@ -322,9 +323,7 @@ class Calibration:
         >>> Calibration.load(p).checksum == cal.checksum
         True
         """
-        from .store import write_calibration
-
-        return write_calibration(self, path, overwrite=overwrite)
+        return write_file(self, path, overwrite=overwrite)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Calibration:
@@ -336,9 +335,7 @@ class Calibration:
             Missing, empty, damaged (checksum) or foreign file; nothing is
             unpickled or evaluated.
         """
-        from .store import read_calibration
-
-        return read_calibration(path)
+        return read_file(Calibration, path)
 
 
 def apply(raw: RawFrames, calibration: Calibration | str | os.PathLike[str]) -> Hologram:

@@ -17,146 +17,31 @@ Layout:
   file is refused rather than read as a slightly different calibration.
 
 Reading parses numbers and JSON only: nothing is unpickled or evaluated.
+
+The codec itself is in ``_format``, which does not import :class:`Calibration`:
+:meth:`Calibration.save` and :meth:`Calibration.load` call it directly, and this
+module (which imports :mod:`.calibration`, never the other way round) keeps the
+functions named after the class.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..io.netcdf import source_from_json, source_to_json
-from ..io.output import check_output, write_via_temp
+from . import _format
+from ._format import FORMAT
+from ._format import SUFFIXES as SUFFIXES
+from ._format import to_dataset as to_dataset
 from .calibration import Calibration
 
 __all__ = ["FORMAT", "read_calibration", "write_calibration"]
 
-FORMAT = "1"
-SUFFIXES = (".nc", ".nc4")
-
-
-def _version() -> str:
-    from .. import __version__
-
-    return __version__
-
-
-def _iq(a: np.ndarray) -> np.ndarray:
-    return np.stack([a.real, a.imag], axis=-1).astype(np.float64)
-
-
-def to_dataset(cal: Calibration) -> Any:
-    """The ``xarray.Dataset`` of a calibration (module text)."""
-    import xarray as xr
-
-    fy, yx = ("frequency", "y", "x", "iq"), ("y", "x")
-
-    def var(dims: tuple[str, ...], values: np.ndarray, long_name: str, units: str) -> Any:
-        return xr.Variable(dims, values, {"long_name": long_name, "units": units})
-
-    data = {
-        "dc": var(fy, np.stack([cal.dc_i, cal.dc_q], axis=-1), "DC offset of the raw I and Q "
-                  "channels", "1"),
-        "iq_gain": var(("frequency",), np.asarray(cal.iq_gain, float), "gain of the Q channel "
-                       "relative to I, as delivered", "1"),
-        "iq_phase": var(("frequency",), np.asarray(cal.iq_phase, float), "phase error of the Q "
-                        "channel, as delivered", "rad"),
-        "response": var(("frequency", "iq"), _iq(cal.response), "complex response common to "
-                        "all elements", "1"),
-        "element_gain": var(fy, _iq(cal.gains), "complex gain of each element relative to "
-                            "the response", "1"),
-        "dead": var(yx, cal.dead.astype(np.int8), "1 = dead element", "1"),
-        "noisy": var(yx, cal.noisy.astype(np.int8), "1 = noisy element", "1"),
-    }
-    coords = {
-        "x": var(("x",), np.asarray(cal.x, float), "element x", "m"),
-        "y": var(("y",), np.asarray(cal.y, float), "element y", "m"),
-        "frequency": var(("frequency",), cal.frequencies, "frequency", "Hz"),
-        "iq": xr.Variable(("iq",), np.array(["I", "Q"]), {"long_name": "I or real part, Q or "
-                                                                       "imaginary part"}),
-    }
-    attrs: dict[str, Any] = {
-        "Conventions": "CF-1.8", "holoradar_kind": "Calibration",
-        "holoradar_calibration_format": FORMAT, "holoradar_version": _version(),
-        "device": cal.device, "iq_sign": cal.iq_sign, "wideband": int(cal.is_wideband),
-        "provenance": json.dumps(cal.provenance, sort_keys=True), "sha256": cal.checksum,
-    }
-    src = source_to_json(cal.source)
-    if src is not None:
-        attrs["source"] = src
-    return xr.Dataset(data, coords=coords, attrs=attrs)
-
 
 def from_dataset(ds: Any, what: str) -> Calibration:
     """Rebuild the :class:`Calibration` that :func:`to_dataset` stored, checking everything."""
-    kind = ds.attrs.get("holoradar_kind")
-    if kind != "Calibration":
-        found = f"a holoradar {kind} file" if kind else "not a holoradar file"
-        raise ValueError(f"{what} is not a holoradar calibration ({found}; variables "
-                         f"{sorted(map(str, ds.variables))})")
-    fmt = str(ds.attrs.get("holoradar_calibration_format"))
-    if fmt != FORMAT:
-        raise ValueError(f"{what}: calibration format {fmt!r} is not known (this holoradar "
-                         f"reads format {FORMAT!r})")
-    need = ["dc", "iq_gain", "iq_phase", "response", "element_gain", "dead", "noisy", "x", "y",
-            "frequency"]
-    missing = [n for n in need if n not in ds.variables]
-    missing += [a for a in ("device", "iq_sign", "wideband", "provenance", "sha256")
-                if a not in ds.attrs]
-    if missing:
-        raise ValueError(f"{what}: the calibration lacks {missing}")
-    dims = {"dc": ("frequency", "y", "x", "iq"), "element_gain": ("frequency", "y", "x", "iq"),
-            "iq_gain": ("frequency",), "iq_phase": ("frequency",),
-            "response": ("frequency", "iq"), "dead": ("y", "x"), "noisy": ("y", "x")}
-    v: dict[str, np.ndarray] = {}
-    for name, d in dims.items():
-        if tuple(ds[name].dims) != d:
-            raise ValueError(f"{what}: variable {name!r} must have dimensions {d}, got "
-                             f"{tuple(ds[name].dims)}")
-        arr = np.asarray(ds[name].values)
-        if not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
-            raise ValueError(f"{what}: variable {name!r} must hold numbers, got {arr.dtype}")
-        v[name] = arr
-    if ds.sizes.get("iq") != 2:
-        raise ValueError(f"{what}: dimension 'iq' must have size 2, got {ds.sizes.get('iq')}")
-    for name in ("dead", "noisy"):
-        if not np.all(np.isin(v[name], (0, 1))):
-            raise ValueError(f"{what}: {name!r} must hold 0 or 1")
-    f = np.asarray(ds["frequency"].values, float).ravel()
-    wide = int(ds.attrs["wideband"])
-    if wide not in (0, 1) or (not wide and f.size != 1):
-        raise ValueError(f"{what}: attribute 'wideband' must be 1, or 0 with one frequency")
-    try:
-        provenance = json.loads(str(ds.attrs["provenance"]))
-    except ValueError:
-        raise ValueError(f"{what}: the provenance attribute is not JSON") from None
-    if not isinstance(provenance, dict):
-        raise ValueError(f"{what}: the provenance attribute must be a JSON object")
-    src = ds.attrs.get("source")
-    try:
-        cal = _build(ds, v, f, wide, src, provenance)
-    except (ValueError, TypeError, KeyError, IndexError) as exc:
-        raise ValueError(f"{what}: {exc}") from None
-    if cal.checksum != str(ds.attrs["sha256"]):
-        raise ValueError(f"{what}: the content does not match its sha256 checksum: the file is "
-                         "damaged or was edited")
-    return cal
-
-
-def _build(ds: Any, v: dict[str, np.ndarray], f: np.ndarray, wide: int, src: Any,
-           provenance: dict[str, Any]) -> Calibration:
-    return Calibration(
-        str(ds.attrs["device"]), np.asarray(ds["x"].values, float),
-        np.asarray(ds["y"].values, float), f if wide else float(f[0]),
-        iq_sign=str(ds.attrs["iq_sign"]),
-        response=v["response"][..., 0] + 1j * v["response"][..., 1],
-        gains=v["element_gain"][..., 0] + 1j * v["element_gain"][..., 1],
-        dc_i=v["dc"][..., 0], dc_q=v["dc"][..., 1], iq_gain=v["iq_gain"],
-        iq_phase=v["iq_phase"], dead=v["dead"].astype(bool), noisy=v["noisy"].astype(bool),
-        source=None if src is None else source_from_json(str(src)), provenance=provenance)
+    return _format.from_dataset(Calibration, ds, what)
 
 
 def write_calibration(cal: Calibration, path: str | os.PathLike[str], *,
@@ -164,44 +49,9 @@ def write_calibration(cal: Calibration, path: str | os.PathLike[str], *,
     """Write ``cal`` to ``path`` (see :meth:`Calibration.save`)."""
     if not isinstance(cal, Calibration):
         raise ValueError(f"cal must be a Calibration, got {type(cal).__name__}")
-    target = check_output(path, suffixes=SUFFIXES, overwrite=overwrite)
-    ds = to_dataset(cal)
-    encoding = {name: {"_FillValue": None} for name in ds.variables if name != "iq"}
-
-    def write(tmp: Path) -> None:
-        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding, invalid_netcdf=False)
-
-    return write_via_temp(target, write)
+    return _format.write_file(cal, path, overwrite=overwrite)
 
 
 def read_calibration(path: str | os.PathLike[str]) -> Calibration:
     """Read a calibration file (see :meth:`Calibration.load`)."""
-    import h5py
-    import xarray as xr
-
-    src = Path(path)
-    if not src.is_file():
-        raise ValueError(f"calibration {str(src)!r} is not a file")
-    if src.stat().st_size == 0:
-        raise ValueError(f"calibration {str(src)!r} is empty")
-    def touch(_name: str, obj: Any) -> None:
-        dict(obj.attrs)
-        if isinstance(obj, h5py.Dataset):
-            obj[()]
-
-    try:  # h5py fails cleanly on a damaged file: read it all before xarray opens it
-        with h5py.File(src, "r") as f:
-            dict(f.attrs)
-            f.visititems(touch)
-    except Exception as exc:
-        raise ValueError(f"calibration {str(src)!r} is not a readable NetCDF-4/HDF5 file "
-                         f"({type(exc).__name__}: {exc})") from None
-    try:
-        with xr.open_dataset(src, engine="h5netcdf") as ds:
-            ds.load()
-            return from_dataset(ds, what=f"calibration {str(src)!r}")
-    except ValueError:
-        raise
-    except Exception as exc:  # a damaged file can fail in the HDF5 layer in many ways
-        raise ValueError(f"calibration {str(src)!r} is not a readable NetCDF-4/HDF5 file "
-                         f"({type(exc).__name__}: {exc})") from None
+    return _format.read_file(Calibration, path)
