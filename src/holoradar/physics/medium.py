@@ -563,6 +563,62 @@ class Medium:
             return air * self._field_in(st, region, z_far)
         return air * self._up_from(st, region, z_far)
 
+    def with_polarization(self, polarization: Polarization) -> Medium:
+        """The same stack with the other Fresnel law (``"TE"`` or ``"TM"``).
+
+        Examples
+        --------
+        >>> Medium.half_space(0.3, 4.0).with_polarization("TM").polarization
+        'TM'
+        """
+        if polarization == self.polarization:
+            return self
+        return Medium(self.z_interfaces, self.eps, polarization)
+
+    def transfer_parts(self, k: float, kappa2: np.ndarray, z_from: float,
+                       z_to: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`vertical_transfer` down from the air, split into its down- and up-going parts.
+
+        At ``z_to`` inside a ground layer the total tangential field is the wave
+        transmitted down plus its reflection from the layers below; a vector
+        model needs them apart (the vertical electric field of a TM wave changes
+        sign with the direction of travel). In the air (above the surface) and in
+        the deepest region the up-going part is zero.
+
+        Returns
+        -------
+        down, up : ndarray
+            Same shape as ``kappa2``; ``down + up == vertical_transfer(...)``.
+
+        Examples
+        --------
+        >>> m = Medium.layered([0.3, 0.35], [4.0, 9.0])
+        >>> k2 = np.array([0.0, 1e4])
+        >>> d, u = m.transfer_parts(200.0, k2, 0.0, 0.32)
+        >>> bool(np.allclose(d + u, m.vertical_transfer(200.0, k2, 0.0, 0.32)))
+        True
+        """
+        kappa2 = np.asarray(kappa2, dtype=float)
+        z_from, z_to = float(z_from), float(z_to)
+        if self.region_of(z_from) != 0 or z_to < z_from:
+            raise ValueError("transfer_parts goes down from the air: z_from must lie above the "
+                             f"surface and z_to below it, got {z_from}, {z_to}")
+        region = self.region_of(z_to)
+        kz0 = self.kz(k, kappa2, 0)
+        if region == 0:
+            return np.exp(1j * kz0 * (z_to - z_from)), np.zeros(kappa2.shape, complex)
+        st = self._interfaces(k, kappa2)
+        amp = np.exp(1j * kz0 * (self.z_interfaces[0] - z_from)) * self._down_into(st, region)
+        top = self.top_of(region)
+        kz = st.kzs[region]
+        down = amp * np.exp(1j * kz * (z_to - top))
+        if region < self.n_regions - 1:
+            bottom = self.z_interfaces[region]
+            up = amp * st.rho[region] * np.exp(1j * kz * (2 * bottom - top - z_to))
+        else:
+            up = np.zeros(kappa2.shape, complex)
+        return down, up
+
     def vertical_transfers(self, k: float, kappa2: np.ndarray, z_from: float,
                            z_to: np.ndarray) -> np.ndarray:
         """:meth:`vertical_transfer` down from ``z_from`` in the air to many ranges at once.
