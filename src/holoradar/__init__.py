@@ -34,7 +34,8 @@ from .imaging.synthesis import align_phases, synthesize
 from .io import load, save
 from .model.scene import Aperture, Scene
 from .model.simulate import simulate
-from .model.targets import PlanarTarget, PointTarget
+from .model.targets import LineTarget, PlanarTarget, PointTarget
+from .physics.dipole import Dipole
 from .physics.medium import Medium, permittivity
 from .physics.parabolic import ParabolicEquation
 from .physics.propagation import AngularSpectrum, Fresnel
@@ -48,12 +49,14 @@ __all__ = [
     "AngularSpectrum",
     "Aperture",
     "AutofocusResult",
+    "Dipole",
     "FitWarning",
     "Fresnel",
     "GaussianBeam",
     "Hologram",
     "IlluminationWarning",
     "Image",
+    "LineTarget",
     "Medium",
     "ObliquePlan",
     "ParabolicEquation",

@@ -151,3 +151,33 @@ def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture", *,
         warnings.warn(f"{what} pitch {pitch * 100:.3g} cm exceeds {label} = "
                       f"{wavelength * 100 / div:.3g} cm: waves arriving more than {theta:.1f} "
                       f"degrees off axis alias", AliasingWarning, stacklevel=3)
+
+
+def as_polarization(value: object, name: str = "polarization") -> np.ndarray | None:
+    """A field direction: a real 3-vector (x, y, z), normalised to unit length; None stays None.
+
+    Examples
+    --------
+    >>> as_polarization((0, 2, 0)).tolist()
+    [0.0, 1.0, 0.0]
+    >>> as_polarization((0, 0, 0))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: polarization must be a non-zero direction (x, y, z) ...
+    """
+    if value is None:
+        return None
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.empty(0)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be a real unit vector (x, y, z) in the scene's axes, e.g. "
+                         f"(0, 1, 0) for a field along y, got {value!r}")
+    nrm = float(np.linalg.norm(arr))
+    if nrm == 0:
+        raise ValueError(f"{name} must be a non-zero direction (x, y, z) of the field "
+                         f"component, got {value!r}")
+    arr = arr / nrm
+    arr.setflags(write=False)
+    return arr

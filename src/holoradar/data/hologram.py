@@ -13,7 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import as_axis, as_finite_complex, check_frequency, uniform_step
+from .._validate import (
+    as_axis,
+    as_finite_complex,
+    as_polarization,
+    check_frequency,
+    uniform_step,
+)
 from .pose import IDENTITY, Pose
 
 __all__ = ["C0", "Hologram", "Image"]
@@ -52,6 +58,15 @@ class Hologram:
         and tilt. ``x`` and ``y`` stay the element coordinates in the aperture's
         own plane; :attr:`points` gives their world positions. Default: the
         identity (the aperture on the plane z = 0, facing down).
+    polarization : (float, float, float), optional
+        Unit vector, in the scene's (world) axes, of the electric-field component
+        the receivers record (normalised here): ``(0, 1, 0)`` for elements that
+        record E_y. With it, and a source that has a polarisation (a
+        :class:`~holoradar.Dipole`, or a plane wave, horn or beam given one),
+        simulation, glare suppression, permittivity estimates and autofocus use
+        the vector model (TE and TM waves, the dipole's near field). Default
+        ``None``: the scalar model, in which the field is the tangential
+        electric field of TE waves only.
 
     Examples
     --------
@@ -72,10 +87,11 @@ class Hologram:
     source: Any = None
     monostatic: bool = False
     pose: Pose = IDENTITY
+    polarization: np.ndarray | None = None
 
     def __init__(self, data: Any, x: Any, y: Any, frequency: Any, *,
                  source: Any = None, monostatic: bool = False,
-                 pose: Pose | None = None) -> None:
+                 pose: Pose | None = None, polarization: Any = None) -> None:
         arr = as_finite_complex(data, "data", min_ndim=2)
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
@@ -91,6 +107,15 @@ class Hologram:
                              "pass source=None")
         if pose is not None and not isinstance(pose, Pose):
             raise ValueError(f"pose must be a holoradar.Pose or None, got {type(pose).__name__}")
+        pol = as_polarization(polarization, "polarization")
+        if pol is not None:
+            normal = (IDENTITY if pose is None else pose).normal
+            if abs(float(pol @ normal)) > 1 - 1e-9:
+                raise ValueError("polarization lies along the line of sight of every receiver "
+                                 f"(the aperture's normal {np.round(normal, 6).tolist()}): the "
+                                 "waves reaching the array have almost no field along it, so "
+                                 "the receivers would record nothing; give the direction of "
+                                 "the recorded component across the array, e.g. (0, 1, 0)")
         arr = arr.copy()  # the hologram owns its data: the caller's array is never shared
         arr.setflags(write=False)
         xa.setflags(write=False)
@@ -102,6 +127,14 @@ class Hologram:
         object.__setattr__(self, "source", source)
         object.__setattr__(self, "monostatic", bool(monostatic))
         object.__setattr__(self, "pose", IDENTITY if pose is None else pose)
+        object.__setattr__(self, "polarization", pol)
+
+    @property
+    def is_vector(self) -> bool:
+        """True when both the recorded component and the source's field are vectors: the
+        vector model applies."""
+        return self.polarization is not None and (self.monostatic
+                                                  or has_polarization(self.source))
 
     @property
     def is_wideband(self) -> bool:
@@ -157,7 +190,8 @@ class Hologram:
         if not -self.nf <= i < self.nf:
             raise ValueError(f"index must be in [0, {self.nf}), got {index}")
         return Hologram(self.data[..., i, :, :], self.x, self.y, float(self.frequencies[i]),
-                        source=self.source, monostatic=self.monostatic, pose=self.pose)
+                        source=self.source, monostatic=self.monostatic, pose=self.pose,
+                        polarization=self.polarization)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -191,15 +225,25 @@ class Hologram:
         (2, 4, 4)
         """
         return Hologram(data, self.x, self.y, self.frequency, source=self.source,
-                        monostatic=self.monostatic, pose=self.pose)
+                        monostatic=self.monostatic, pose=self.pose,
+                        polarization=self.polarization)
 
     def replace(self, **changes: Any) -> Hologram:
         """A copy with some fields replaced (``dataclasses.replace`` semantics)."""
         kw = {"data": self.data, "x": self.x, "y": self.y, "frequency": self.frequency,
-              "source": self.source, "monostatic": self.monostatic, "pose": self.pose}
+              "source": self.source, "monostatic": self.monostatic, "pose": self.pose,
+              "polarization": self.polarization}
         kw.update(changes)
         src, mono, pose = kw.pop("source"), kw.pop("monostatic"), kw.pop("pose")
-        return Hologram(**kw, source=src, monostatic=mono, pose=pose)
+        pol = kw.pop("polarization")
+        return Hologram(**kw, source=src, monostatic=mono, pose=pose, polarization=pol)
+
+
+def has_polarization(source: Any) -> bool:
+    """True when ``source`` gives a vector field (a Dipole, or a source given a
+    ``polarization``)."""
+    return getattr(source, "polarization", None) is not None and hasattr(source,
+                                                                          "field_vector")
 
 
 def _frequency_axis(frequency: Any, shape: tuple[int, ...]) -> float | np.ndarray:

@@ -8,11 +8,11 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import as_axis
+from .._validate import as_axis, as_polarization
 from ..data.pose import IDENTITY, Pose
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave
-from .targets import PlanarTarget, PointTarget
+from .targets import LineTarget, PlanarTarget, PointTarget
 
 __all__ = ["Aperture", "Scene"]
 
@@ -36,6 +36,10 @@ class Aperture:
     pose : Pose
         Where the aperture's plane stands in the world (default: the plane z = 0,
         facing down); ``x``, ``y`` and ``elements`` are coordinates in that plane.
+    polarization : (float, float, float), optional
+        Unit vector (world axes) of the field component the elements record;
+        with a polarised source, :func:`holoradar.simulate` uses the vector model
+        and the hologram carries it. Default ``None``: the scalar model.
 
     Examples
     --------
@@ -50,8 +54,11 @@ class Aperture:
     elements: np.ndarray | None = None
     monostatic: bool = False
     pose: Pose = IDENTITY
+    polarization: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        pol = as_polarization(self.polarization, "polarization")
+        object.__setattr__(self, "polarization", pol)
         if self.pose is None:
             object.__setattr__(self, "pose", IDENTITY)
         if not isinstance(self.pose, Pose):
@@ -70,13 +77,13 @@ class Aperture:
 
     @classmethod
     def from_positions(cls, positions: np.ndarray, *, monostatic: bool = False,
-                       pose: Pose | None = None) -> Aperture:
+                       pose: Pose | None = None, polarization: Any = None) -> Aperture:
         """Elements at arbitrary positions (N, 2) in the aperture's plane, metres."""
         el = np.asarray(positions, dtype=float)
         if el.ndim != 2 or el.shape[1] != 2:
             raise ValueError(f"positions must have shape (N, 2), got {el.shape}")
         xs, ys = np.unique(el[:, 0]), np.unique(el[:, 1])
-        return cls(xs, ys, el, monostatic, pose or IDENTITY)
+        return cls(xs, ys, el, monostatic, pose or IDENTITY, polarization)
 
     @property
     def is_grid(self) -> bool:
@@ -86,12 +93,18 @@ class Aperture:
     @classmethod
     def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
              center: tuple[float, float] = (0.0, 0.0), monostatic: bool = False,
-             pose: Pose | None = None) -> Aperture:
+             pose: Pose | None = None, polarization: Any = None) -> Aperture:
         """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``.
 
         ``monostatic=True`` makes it the scan grid of one transceiver; ``pose``
         places and tilts its plane (``center`` is then in the aperture's own
-        coordinates; the pose's centre is the world position of their origin).
+        coordinates; the pose's centre is the world position of their origin);
+        ``polarization`` is the recorded field component (world axes).
+
+        Examples
+        --------
+        >>> Aperture.grid(24, 0.015, polarization=(0, 1, 0)).polarization.tolist()
+        [0.0, 1.0, 0.0]
         """
         for name, v in (("n", n), ("ny", ny)):
             if v is not None and (not float(v).is_integer() or int(v) < 1):
@@ -102,7 +115,8 @@ class Aperture:
         py = pitch if pitch_y is None else pitch_y
         x = (np.arange(int(n)) - (int(n) - 1) / 2) * pitch + center[0]
         y = (np.arange(ny) - (ny - 1) / 2) * py + center[1]
-        return cls(x, y, monostatic=monostatic, pose=pose or IDENTITY)
+        return cls(x, y, monostatic=monostatic, pose=pose or IDENTITY,
+                   polarization=polarization)
 
     @classmethod
     def paper(cls) -> Aperture:
@@ -133,9 +147,9 @@ class Scene:
     ----------
     medium : Medium
         Layered ground (default free space).
-    source : PlaneWave, PointSource or GaussianBeam
+    source : PlaneWave, PointSource, GaussianBeam or Dipole
         Illumination (default: a normal plane wave).
-    targets : sequence of PointTarget or PlanarTarget
+    targets : sequence of PointTarget, LineTarget or PlanarTarget
         The scatterers.
 
     Examples
@@ -147,17 +161,17 @@ class Scene:
 
     medium: Medium = field(default_factory=Medium.free_space)
     source: Any = field(default_factory=PlaneWave)
-    targets: Sequence[PointTarget | PlanarTarget] = ()
+    targets: Sequence[PointTarget | LineTarget | PlanarTarget] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.medium, Medium):
             raise ValueError("medium must be a holoradar.Medium, got "
                              f"{type(self.medium).__name__}")
         if not (hasattr(self.source, "field") and hasattr(self.source, "reflected")):
-            raise ValueError("source must be a PlaneWave, PointSource or GaussianBeam")
+            raise ValueError("source must be a PlaneWave, PointSource, GaussianBeam or Dipole")
         tg = tuple(self.targets)
         for i, t in enumerate(tg):
-            if not isinstance(t, PointTarget | PlanarTarget):
-                raise ValueError(f"targets[{i}] must be a PointTarget or PlanarTarget, got "
-                                 f"{type(t).__name__}")
+            if not isinstance(t, PointTarget | PlanarTarget | LineTarget):
+                raise ValueError(f"targets[{i}] must be a PointTarget, LineTarget or "
+                                 f"PlanarTarget, got {type(t).__name__}")
         object.__setattr__(self, "targets", tg)

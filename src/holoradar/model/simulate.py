@@ -10,7 +10,21 @@ The recorded field is the sum of (each optional):
 * the direct field of the source at the aperture;
 * circular complex Gaussian receiver noise at a given SNR.
 
-Point targets use the exact Sommerfeld integral (:mod:`..physics.green`). A
+Point targets use the exact Sommerfeld integral (:mod:`..physics.green`).
+
+Vector model: when the elements record one component ``u`` of the electric
+field (``Aperture(..., polarization=u)``) and the source's field is a vector (a
+:class:`~holoradar.Dipole`, or a source given a ``polarization``), every wave
+is the electric dipole's: the incident field (direct, or transmitted through the
+stack with the TE and TM coefficients), each point target an induced dipole
+``p = alpha E`` (a line a row of them), its field at the elements ``G p`` with
+the dyadic Green's function (:mod:`..physics.dyadic`), and the recorded value
+``u . E``. A scanned transceiver sends and receives along ``u``. Planar targets
+keep the scalar Kirchhoff model, lit by the incident field's component along
+``u``. A target in the air (above the surface) is lit, and seen, by the direct
+wave and its reflection from the ground.
+
+A
 planar target's reflected field ``f*E0`` is carried by its angular spectrum
 (non-paraxial), evaluated exactly at the receivers by a direct (non-uniform)
 Fourier sum. Rays that would land far (> 10 wavelengths) off every receiver are
@@ -25,13 +39,14 @@ from __future__ import annotations
 import numpy as np
 from tqdm.auto import tqdm
 
-from .._validate import as_real, check_frequency
-from ..data.hologram import C0, Hologram, _frequency_axis
+from .._validate import as_polarization, as_real, check_frequency
+from ..data.hologram import C0, Hologram, _frequency_axis, has_polarization
+from ..physics.dyadic import RadialDyadic, reflected_dyadic, transmitted_dyadic
 from ..physics.green import free_space_green, green_at_distances
 from ..physics.medium import Medium
 from ..physics.propagation import lateral_travel
 from .scene import Aperture, Scene
-from .targets import PlanarTarget, PointTarget
+from .targets import LineTarget, PlanarTarget, PointTarget
 
 __all__ = ["simulate"]
 
@@ -42,7 +57,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
              include_targets: bool = True, include_surface: bool = True,
              include_direct: bool = False, snr_db: float | None = None,
              seed: int | None = None, monostatic: bool | None = None,
-             progress: bool = False) -> Hologram | np.ndarray:
+             polarization: object = None, progress: bool = False) -> Hologram | np.ndarray:
     """Simulate the hologram of ``scene`` recorded by ``aperture`` at ``frequency``.
 
     Parameters
@@ -74,6 +89,10 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         ``a * G(element, target)^2`` (``G`` the exact layered Green's function,
         symmetric by reciprocity); the scene's source is not used. Default: the
         aperture's own ``monostatic`` (False for bare positions).
+    polarization : (float, float, float), optional
+        The field component the elements record (world axes); default the
+        aperture's own ``polarization``. With a polarised source (or a
+        monostatic aperture) the vector model is used (module notes).
     progress : bool, optional
         Show a progress bar over the frequencies once the work has taken a second
         (default False).
@@ -115,6 +134,15 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
     mono = (bool(getattr(aperture, "monostatic", False)) if monostatic is None
             else bool(monostatic))
     medium, source = scene.medium, scene.source
+    pol = as_polarization(polarization if polarization is not None
+                          else getattr(aperture, "polarization", None), "polarization")
+    vector = pol is not None and (mono or has_polarization(source))
+    if pol is not None and not vector:
+        import warnings
+
+        warnings.warn("simulate: the elements record a polarisation but the source has none "
+                      "(give it one, or use a Dipole): the scalar model is used",
+                      UserWarning, stacklevel=2)
     if not medium.is_free_space and np.any(pts[:, 2] >= medium.z_interfaces[0]):
         raise ValueError(f"aperture: its elements must lie above the ground surface (z < "
                          f"{medium.z_interfaces[0]} m); the deepest is at z = "
@@ -130,7 +158,13 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
     rows = []
     for f in tqdm(freqs, desc="simulate", unit="frequency", disable=not progress, delay=1.0):
         k = 2 * np.pi * f / C0
-        if mono:
+        if vector and mono:
+            total = _monostatic_vector(k, medium, scene, pts, pol, include_targets,
+                                       include_surface)
+        elif vector:
+            total = _bistatic_vector(k, medium, scene, pts, pol, include_targets,
+                                     include_surface, include_direct)
+        elif mono:
             total = _monostatic(k, medium, scene, pts, include_targets, include_surface)
         else:
             total = _bistatic(k, medium, scene, pts, include_targets, include_surface,
@@ -146,8 +180,146 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         shape = (*data.shape[:-1], aperture.y.size, aperture.x.size)
         return Hologram(data.reshape(shape), aperture.x, aperture.y,
                         freqs if wide else float(freqs[0]),
-                        source=None if mono else source, monostatic=mono, pose=aperture.pose)
+                        source=None if mono else source, monostatic=mono, pose=aperture.pose,
+                        polarization=pol)
     return data
+
+
+def _scalar_points(k: float, medium: Medium, targets: object) -> list[PointTarget]:
+    """Point targets, and each line as a row of points: the scalar model sees a line's
+    response to a field along its axis."""
+    out = [t for t in targets if isinstance(t, PointTarget)]
+    for t in targets:
+        if isinstance(t, LineTarget):
+            pos, alpha = t.dipoles(k, _region_eps(medium, t.start[2]))
+            along = complex(t.direction @ alpha[0] @ t.direction)
+            out += [PointTarget(p, along) for p in pos]
+    return out
+
+
+def _region_eps(medium: Medium, z: float) -> complex:
+    return complex(medium.eps[medium.region_of(float(z))])
+
+
+def _dipoles(k: float, medium: Medium, targets: list) -> tuple[np.ndarray, np.ndarray]:
+    """Every point and line target as induced dipoles: positions (M, 3), tensors (M, 3, 3)."""
+    pos, alpha = [], []
+    for t in targets:
+        if isinstance(t, PointTarget):
+            pos.append(t.position[None, :])
+            alpha.append(t.tensor[None])
+        elif isinstance(t, LineTarget):
+            zs = (t.start[2], t.end[2])
+            if medium.region_of(min(zs)) != medium.region_of(max(zs)):
+                raise ValueError("a LineTarget must lie within one layer of the ground (it "
+                                 "crosses an interface)")
+            p, a = t.dipoles(k, _region_eps(medium, zs[0]))
+            pos.append(p)
+            alpha.append(np.asarray(a))
+    if not pos:
+        return np.zeros((0, 3)), np.zeros((0, 3, 3), complex)
+    return np.concatenate(pos), np.concatenate(alpha)
+
+
+def _receiving(k: float, medium: Medium, z_e: float, z_t: float, offsets: np.ndarray
+               ) -> np.ndarray:
+    """G(r_t, r_e) (N, 3, 3): the field at targets (offsets r_t - r_e, range z_t) of a
+    dipole at each element (range z_e); its transpose is the target's field at the
+    element (reciprocity). A target in the air gets the direct wave and the ground's
+    reflection."""
+    src = np.array([0.0, 0.0, z_e])
+    pts = np.c_[offsets, np.full(len(offsets), z_t)]
+    if medium.is_free_space or medium.region_of(z_t) == 0:
+        if z_t >= z_e:
+            G = transmitted_dyadic(k, medium, src, pts)
+        else:
+            from ..physics.dyadic import free_space_dyadic
+            G = free_space_dyadic(k, src, pts)
+        if not medium.is_free_space:
+            G = G + reflected_dyadic(k, medium, src, pts)
+        return G
+    rho_max = float(np.hypot(offsets[:, 0], offsets[:, 1]).max(initial=0.0))
+    table_size = rho_max / (2 * np.pi / (k * max(abs(medium.n(m)) for m in
+                                                 range(medium.n_regions))) / 16)
+    if len(offsets) > 2 * table_size:
+        return RadialDyadic(k, medium, z_e, z_t, rho_max)(offsets)
+    return transmitted_dyadic(k, medium, src, pts)
+
+
+def _incident_vector(k: float, medium: Medium, source: object, pos: np.ndarray) -> np.ndarray:
+    E = source.field_vector(k, medium, pos)
+    if not medium.is_free_space:
+        air = np.asarray(medium.region_of(pos[:, 2])) == 0
+        if np.any(air):
+            E[air] = E[air] + source.reflected_vector(k, medium, pos[air])
+    return E
+
+
+def _bistatic_vector(k: float, medium: Medium, scene: Scene, pts: np.ndarray, pol: np.ndarray,
+                     include_targets: bool, include_surface: bool,
+                     include_direct: bool) -> np.ndarray:
+    """A receiver array recording ``pol . E`` of a polarised source's scene."""
+    source = scene.source
+    total = np.zeros(len(pts), complex)
+    if include_targets:
+        pos, alpha = _dipoles(k, medium, list(scene.targets))
+        if len(pos):
+            P = np.einsum("mij,mj->mi", alpha, _incident_vector(k, medium, source, pos))
+            for zt in np.unique(pos[:, 2]):
+                st = np.nonzero(pos[:, 2] == zt)[0]
+                for ze in np.unique(pts[:, 2]):
+                    se = np.nonzero(pts[:, 2] == ze)[0]
+                    off = (pos[st, None, :2] - pts[None, se, :2]).reshape(-1, 2)
+                    G = _receiving(k, medium, float(ze), float(zt), off)      # G(r_t, r_e)
+                    Gu = (G @ pol).reshape(st.size, se.size, 3)
+                    total[se] += np.einsum("mi,mei->e", P[st], Gu)
+        planar = [t for t in scene.targets if isinstance(t, PlanarTarget)]
+        if planar:
+            along = _AlongPolarization(source, pol)
+            for t in planar:
+                total += _planar_target(k, medium, along, t, pts)
+    if include_surface and not medium.is_free_space:
+        total += source.reflected_vector(k, medium, pts) @ pol
+    if include_direct:
+        total += source.field_vector(k, medium, pts) @ pol
+    return total
+
+
+class _AlongPolarization:
+    """A polarised source seen through one field component (the scalar Kirchhoff model)."""
+
+    def __init__(self, source: object, pol: np.ndarray) -> None:
+        self.source, self.pol = source, pol
+
+    def field(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
+        return self.source.field_vector(k, medium, points) @ self.pol
+
+
+def _monostatic_vector(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
+                       pol: np.ndarray, include_targets: bool,
+                       include_surface: bool) -> np.ndarray:
+    """Scanned transceivers sending and receiving along ``pol``: ``v . alpha v``, with
+    ``v = G(r_t, r_e) pol`` the transceiver's field at the target (reciprocity)."""
+    total = np.zeros(len(pts), complex)
+    if include_targets:
+        if any(isinstance(t, PlanarTarget) for t in scene.targets):
+            raise ValueError("planar targets are not modelled for a monostatic aperture")
+        pos, alpha = _dipoles(k, medium, list(scene.targets))
+        for zt in np.unique(pos[:, 2]):
+            st = np.nonzero(pos[:, 2] == zt)[0]
+            for ze in np.unique(pts[:, 2]):
+                se = np.nonzero(pts[:, 2] == ze)[0]
+                off = (pos[st, None, :2] - pts[None, se, :2]).reshape(-1, 2)
+                v = (_receiving(k, medium, float(ze), float(zt), off) @ pol).reshape(
+                    st.size, se.size, 3)
+                total[se] += np.einsum("mei,mij,mej->e", v, alpha[st], v)
+    if include_surface and not medium.is_free_space:
+        for ze in np.unique(pts[:, 2]):
+            se = pts[:, 2] == ze
+            G = reflected_dyadic(k, medium, np.array([0.0, 0.0, ze]),
+                                 np.array([[0.0, 0.0, ze]]))[0]
+            total[se] += pol @ G @ pol
+    return total
 
 
 def _bistatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray, include_targets: bool,
@@ -156,7 +328,7 @@ def _bistatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray, include_t
     source = scene.source
     total = np.zeros(len(pts), complex)
     if include_targets:
-        points = [t for t in scene.targets if isinstance(t, PointTarget)]
+        points = _scalar_points(k, medium, scene.targets)
         if points:
             total += _point_targets(k, medium, source, points, pts)
         for t in scene.targets:
@@ -174,7 +346,7 @@ def _monostatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
     """Scanned transceivers: each element's echo of its own point-source wave."""
     total = np.zeros(len(pts), complex)
     if include_targets:
-        targets = [t for t in scene.targets if isinstance(t, PointTarget)]
+        targets = _scalar_points(k, medium, scene.targets)
         for zt in sorted({float(t.position[2]) for t in targets}):
             group = [t for t in targets if t.position[2] == zt]
             pos = np.array([t.position for t in group])

@@ -67,7 +67,7 @@ from scipy.special import j0, j1
 from .green import _nodes, _phase_length
 from .medium import Medium
 
-__all__ = ["buried_dipole_dyadic", "free_space_dyadic", "reflected_dyadic",
+__all__ = ["RadialDyadic", "buried_dipole_dyadic", "free_space_dyadic", "reflected_dyadic",
            "transmitted_dyadic"]
 
 
@@ -105,27 +105,40 @@ def _j2(x: np.ndarray, J0: np.ndarray, J1: np.ndarray) -> np.ndarray:
     return np.where(small, x * x / 8, 2 * J1 / safe - J0)
 
 
+def _profiles(rho: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
+              reflected: bool, chunk: int = 2048) -> np.ndarray:
+    """The five radial functions (A, B, C, Z, D) at distances ``rho``: shape (5, N)."""
+    out = np.zeros((5, rho.size), complex)
+    for c0 in range(0, rho.size, chunk):
+        r = rho[c0:c0 + chunk]
+        for kap, w, (kA, kB, kC, kZ, kD) in quad:
+            x = np.outer(r, kap)
+            J0, J1 = j0(x), j1(x)
+            J2 = _j2(x, J0, J1)
+            out[0, c0:c0 + chunk] += J0 @ (w * kA)
+            out[1, c0:c0 + chunk] += J2 @ (w * kB)
+            out[2, c0:c0 + chunk] += J1 @ (w * kC)
+            out[4, c0:c0 + chunk] += J0 @ (w * kD)
+            if not reflected:
+                out[3, c0:c0 + chunk] += J1 @ (w * kZ)
+    if reflected:
+        out[3] = -out[2]
+    return out
+
+
 def _assemble(offsets: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
               reflected: bool) -> np.ndarray:
     """Sum the kernels' Hankel transforms at lateral ``offsets`` (N, 2) and build G."""
     rho = np.hypot(offsets[:, 0], offsets[:, 1])
+    return _build(offsets, _profiles(rho, quad, reflected))
+
+
+def _build(offsets: np.ndarray, prof: np.ndarray) -> np.ndarray:
+    """G (N, 3, 3) from the radial functions (5, N) and the offsets' azimuths."""
     a = np.arctan2(offsets[:, 1], offsets[:, 0])
     c1, s1, c2, s2 = np.cos(a), np.sin(a), np.cos(2 * a), np.sin(2 * a)
-    A = np.zeros(rho.size, complex)
-    B, C, Z, D = (np.zeros(rho.size, complex) for _ in range(4))
-    for kap, w, (kA, kB, kC, kZ, kD) in quad:
-        x = np.outer(rho, kap)
-        J0, J1 = j0(x), j1(x)
-        J2 = _j2(x, J0, J1)
-        A += J0 @ (w * kA)
-        B += J2 @ (w * kB)
-        C += J1 @ (w * kC)
-        D += J0 @ (w * kD)
-        if not reflected:
-            Z += J1 @ (w * kZ)
-    if reflected:
-        Z = -C
-    G = np.empty((rho.size, 3, 3), complex)
+    A, B, C, Z, D = prof
+    G = np.empty((offsets.shape[0], 3, 3), complex)
     G[:, 0, 0] = A + B * c2
     G[:, 1, 1] = A - B * c2
     G[:, 0, 1] = G[:, 1, 0] = B * s2
@@ -307,3 +320,72 @@ def buried_dipole_dyadic(k: float, medium: Medium, src: np.ndarray, pts: np.ndar
         down = transmitted_dyadic(k, medium, np.array([0.0, 0.0, z_air]), rel)
         out[sel] = np.swapaxes(down, 1, 2)
     return out
+
+
+class RadialDyadic:
+    """G between one source range and one observation range, for many lateral offsets.
+
+    The stack is invariant along x and y, so ``G`` is five functions of the
+    lateral distance (the module's A, B, C, Z, D) and trigonometric functions of
+    the azimuth. They are computed once on a radial grid (spacing a sixteenth of
+    the shortest wavelength in the stack) and interpolated by cubic splines of
+    their real and imaginary parts after removing the phase of ``A`` (the
+    propagation phase all five share): what is left varies on the scale of the
+    ranges, not of the wavelength.
+
+    Parameters
+    ----------
+    k : float
+        Wavenumber in air, rad/m.
+    medium : Medium
+    z_src, z_obs : float
+        Ranges of the source (in the air) and of the observation points, metres.
+    rho_max : float
+        Largest lateral distance asked for, metres.
+    kind : {"transmitted", "reflected"}
+        As :func:`transmitted_dyadic` or :func:`reflected_dyadic`.
+
+    Examples
+    --------
+    >>> m = Medium.half_space(0.3, 4.0)
+    >>> tab = RadialDyadic(200.0, m, 0.0, 0.4, 0.3)
+    >>> off = np.array([[0.1, 0.05], [-0.2, 0.1]])
+    >>> exact = transmitted_dyadic(200.0, m, np.zeros(3), np.c_[off, [0.4, 0.4]])
+    >>> bool(np.abs(tab(off) - exact).max() < 1e-6 * np.abs(exact).max())
+    True
+    """
+
+    def __init__(self, k: float, medium: Medium, z_src: float, z_obs: float, rho_max: float,
+                 kind: str = "transmitted") -> None:
+        from scipy.interpolate import CubicSpline
+
+        n_max = max(abs(medium.n(m)) for m in range(medium.n_regions))
+        step = 2 * np.pi / (k * n_max) / 16
+        self.rho = np.arange(0.0, float(rho_max) + 3 * step, step)
+        z0 = medium.z_interfaces[0] if not medium.is_free_space else np.inf
+        if kind == "reflected":
+            L = (z0 - z_src) + (z0 - z_obs)
+            pieces = _nodes(k, medium, L + _phase_length(medium, z0, z0), self.rho[-1], L)
+            quad = [(kap, w, _reflected_kernels(k, medium, kap, L)) for kap, w in pieces]
+        else:
+            air_len = max(0.0, min(z0, z_obs) - z_src)
+            pieces = _nodes(k, medium, _phase_length(medium, z_src, z_obs), self.rho[-1],
+                            air_len)
+            quad = [(kap, w, _transmitted_kernels(k, medium, kap, z_src, z_obs))
+                    for kap, w in pieces]
+        prof = _profiles(self.rho, quad, kind == "reflected")
+        phase = np.unwrap(np.angle(prof[0]))
+        demod = prof * np.exp(-1j * phase)
+        self._phase = CubicSpline(self.rho, phase)
+        self._re = CubicSpline(self.rho, demod.real, axis=1)
+        self._im = CubicSpline(self.rho, demod.imag, axis=1)
+
+    def __call__(self, offsets: np.ndarray) -> np.ndarray:
+        """G (N, 3, 3) at lateral ``offsets`` (N, 2) = observation - source, metres."""
+        off = np.atleast_2d(np.asarray(offsets, float))
+        rho = np.hypot(off[:, 0], off[:, 1])
+        if rho.size and rho.max() > self.rho[-1]:
+            raise ValueError(f"RadialDyadic: offset {rho.max():.4g} m beyond the table's "
+                             f"{self.rho[-1]:.4g} m")
+        prof = (self._re(rho) + 1j * self._im(rho)) * np.exp(1j * self._phase(rho))
+        return _build(off, prof)

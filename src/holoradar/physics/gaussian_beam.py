@@ -10,9 +10,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import as_complex_scalar, as_position, as_real
+from .._validate import as_complex_scalar, as_polarization, as_position, as_real
 from ._geometry import _points
 from .medium import Medium
+from .vector_waves import transverse, vector_transfer
 
 __all__ = ["GaussianBeam"]
 
@@ -31,6 +32,11 @@ class GaussianBeam:
         Tilt of the beam axis from z towards x and y, radians.
     amplitude : complex, optional
         Field at the waist centre.
+    polarization : (float, float, float), optional
+        Direction of the electric field at the waist (world axes; its part across
+        the beam's axis is kept, normalised): the vector model, each plane-wave
+        component carrying ``E`` split into TE and TM parts
+        (:mod:`holoradar.physics.vector_waves`). Default ``None``: scalar.
 
     Notes
     -----
@@ -53,6 +59,7 @@ class GaussianBeam:
     alpha: float = 0.0
     beta: float = 0.0
     amplitude: complex = 1.0
+    polarization: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         w = as_real(self.waist, "waist") if not isinstance(self.waist, str) else -1.0
@@ -66,6 +73,45 @@ class GaussianBeam:
             raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
                              f"propagating beam), got alpha={self.alpha}, beta={self.beta}")
         object.__setattr__(self, "amplitude", as_complex_scalar(self.amplitude, "amplitude"))
+        pol = as_polarization(self.polarization, "polarization")
+        if pol is not None:
+            pol = transverse(self.direction, pol)
+            object.__setattr__(self, "polarization", tuple(float(v) for v in pol))
+
+    def _vector(self, k: float, medium: Medium, points: np.ndarray, reflected: bool
+                ) -> np.ndarray:
+        if self.polarization is None:
+            raise ValueError("this GaussianBeam has no polarization: give GaussianBeam(..., "
+                             "polarization=(ux, uy, uz)) for the vector model")
+        pts = _points(points)
+        out = np.zeros((len(pts), 3), complex)
+        if reflected and medium.is_free_space:
+            return out
+        grid_pts = pts
+        if reflected:
+            grid_pts = pts.copy()
+            grid_pts[:, 2] = 2 * medium.z_interfaces[0] - pts[:, 2]
+        P, Q, A, dpq = self._spectrum(k, grid_pts)
+        keep = A != 0
+        e = np.array(self.polarization)
+        for z in np.unique(pts[:, 2]):
+            sel = pts[:, 2] == z
+            V = np.zeros((*P.shape, 3), complex)
+            V[keep] = vector_transfer(k, medium, P[keep], Q[keep], e, float(self.center[2]),
+                                      float(z), reflected=reflected)
+            for c in range(3):
+                S = np.where(keep, A * V[..., c], 0)
+                if np.any(S):
+                    out[sel, c] = self._sum(P, Q, S, pts[sel]) * dpq / (4 * np.pi**2)
+        return out
+
+    def field_vector(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
+        """Incident electric field vectors (N, 3) at ``points`` (N, 3)."""
+        return self._vector(k, medium, points, False)
+
+    def reflected_vector(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
+        """The beam's specular reflection (N, 3) at air ``points``."""
+        return self._vector(k, medium, points, True)
 
     def _spectrum(self, k: float, pts: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

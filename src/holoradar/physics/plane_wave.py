@@ -10,9 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_real
+from .._validate import as_polarization, as_real
 from ._geometry import _points
 from .medium import Medium
+from .vector_waves import transverse, vector_transfer
 
 __all__ = ["PlaneWave"]
 
@@ -26,6 +27,11 @@ class PlaneWave:
     alpha, beta : float
         Angles from the z axis towards x and towards y, radians. The transverse
         wavenumbers are ``p0 = k*sin(alpha)``, ``q0 = k*sin(beta)``.
+    polarization : (float, float, float), optional
+        Direction of the electric field in the scene's axes (its part across the
+        direction of travel is kept, normalised): ``(0, 1, 0)`` for E along y.
+        With it the wave is a vector field (:meth:`field_vector`): TE and TM parts
+        cross the ground with their own Fresnel laws. Default ``None``: scalar.
 
     Notes
     -----
@@ -37,10 +43,13 @@ class PlaneWave:
     --------
     >>> [round(v, 3) for v in PlaneWave(np.radians(10), 0.0).wavenumbers(200.0)]
     [34.73, 0.0]
+    >>> PlaneWave(polarization=(0, 1, 0)).polarization
+    (0.0, 1.0, 0.0)
     """
 
     alpha: float = 0.0
     beta: float = 0.0
+    polarization: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "alpha", as_real(self.alpha, "alpha"))
@@ -48,6 +57,43 @@ class PlaneWave:
         if np.sin(self.alpha) ** 2 + np.sin(self.beta) ** 2 >= 1:
             raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
                              f"propagating wave), got alpha={self.alpha}, beta={self.beta}")
+        pol = as_polarization(self.polarization, "polarization")
+        if pol is not None:
+            pol = transverse(self.direction, pol)
+            object.__setattr__(self, "polarization", tuple(float(v) for v in pol))
+
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit vector of travel (towards +z)."""
+        sa, sb = np.sin(self.alpha), np.sin(self.beta)
+        return np.array([sa, sb, np.sqrt(1 - sa * sa - sb * sb)])
+
+    def _vector(self, k: float, medium: Medium, points: np.ndarray, reflected: bool
+                ) -> np.ndarray:
+        if self.polarization is None:
+            raise ValueError("this PlaneWave has no polarization: give "
+                             "PlaneWave(..., polarization=(ux, uy, uz)) for the vector model")
+        pts = _points(points)
+        p0, q0 = self.wavenumbers(k)
+        lateral = np.exp(1j * (p0 * pts[:, 0] + q0 * pts[:, 1]))
+        out = np.zeros((len(pts), 3), complex)
+        if reflected and medium.is_free_space:
+            return out
+        e = np.array(self.polarization)
+        for z in np.unique(pts[:, 2]):
+            sel = pts[:, 2] == z
+            v = vector_transfer(k, medium, np.array(p0), np.array(q0), e, 0.0, float(z),
+                                reflected=reflected)
+            out[sel] = lateral[sel, None] * v
+        return out
+
+    def field_vector(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
+        """Incident (down-going) electric field vectors (N, 3) at ``points`` (N, 3)."""
+        return self._vector(k, medium, points, False)
+
+    def reflected_vector(self, k: float, medium: Medium, points: np.ndarray) -> np.ndarray:
+        """Its specular reflection from the ground (N, 3) at air ``points``."""
+        return self._vector(k, medium, points, True)
 
     def wavenumbers(self, k: float) -> tuple[float, float]:
         """Transverse wavenumbers ``(p0, q0)`` in rad/m."""

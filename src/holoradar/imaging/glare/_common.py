@@ -9,15 +9,31 @@ from dataclasses import replace
 
 import numpy as np
 
+from ...data.hologram import Hologram, has_polarization
+from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.sources import GaussianBeam, PointSource
 
+Radiator = PointSource | GaussianBeam | Dipole
 
-def _direct_wave(src: PointSource | GaussianBeam, k: float, pts: np.ndarray) -> np.ndarray:
+
+def _recorded(hologram: Hologram, src: object) -> np.ndarray | None:
+    """The recorded field component when the vector model applies, else None."""
+    if hologram.polarization is not None and has_polarization(src):
+        return np.asarray(hologram.polarization)
+    return None
+
+
+def _direct_wave(src: Radiator, k: float, pts: np.ndarray,
+                 pol: np.ndarray | None = None) -> np.ndarray:
     """The radiator's own wave at air points, for unit amplitude: ``exp(ikR)/R`` times its
     pattern along the straight ray, or the incoming Gaussian beam (the shape the
-    direct-wave fit scales)."""
-    return replace(src, amplitude=1.0).field(k, Medium.free_space(), pts)
+    direct-wave fit scales); with ``pol``, the component ``pol . E`` of its vector
+    field."""
+    unit = replace(src, amplitude=1.0)
+    if pol is not None:
+        return unit.field_vector(k, Medium.free_space(), pts) @ pol
+    return unit.field(k, Medium.free_space(), pts)
 
 
 def _joint_direct(h: np.ndarray, glare: np.ndarray, D: np.ndarray | None

@@ -60,7 +60,8 @@ def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
 def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarray,
                       h: np.ndarray, D: np.ndarray | None, ref: complex | None,
                       initial: dict[str, Any] | None,
-                      transform: Callable[[np.ndarray], np.ndarray]):
+                      transform: Callable[[np.ndarray], np.ndarray],
+                      pol: np.ndarray | None = None):
     """Fit the ground's permittivity from the exact reflected field.
 
     The glare's strength relative to the radiator's fixes |V|: the radiator's
@@ -68,13 +69,20 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
     for both, since both are its fields: the direct path is the reference) or
     given (``ref``, a calibration). Fitting it freely for the glare alone would
     leave eps to the weak angle dependence of V across the aperture.
+
+    With ``pol`` (the recorded component) the glare is the vector field of the
+    radiator reflected by the stack, its TE and TM waves each with their own
+    coefficients (:func:`holoradar.physics.dyadic.reflected_dyadic`).
     """
     eps0 = complex(initial["eps"]) if initial and "eps" in initial else complex(medium.eps[1])
 
     def glare_of(e: np.ndarray) -> np.ndarray:
         eps = complex(max(e[0], 1e-3), max(e[1], 0.0))
         m = Medium(medium.z_interfaces, (1.0, eps, *medium.eps[2:]), medium.polarization)
-        return replace(src, amplitude=1.0).reflected(k, m, pts)
+        unit = replace(src, amplitude=1.0)
+        if pol is not None:
+            return unit.reflected_vector(k, m, pts) @ pol
+        return unit.reflected(k, m, pts)
 
     th = transform(h)
     tD = None if D is None else transform(D)

@@ -7,9 +7,10 @@ from typing import Any
 import numpy as np
 
 from ...data.hologram import Hologram
+from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _direct_wave
+from ._common import _direct_wave, _recorded
 from .suppress import suppress_surface
 
 __all__ = ["estimate_permittivity"]
@@ -24,9 +25,13 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     radiator's amplitude is the direct wave's, fitted jointly (``direct=True``,
     the direct-path reference; it must be in the data), or ``source.amplitude``
     (``direct=False``, a calibration). ``medium`` supplies the geometry and the
-    starting value. The 1-sigma covers receiver noise and diffuse clutter (a
-    sandwich estimate); it does not cover model error (a vector source seen as
-    a scalar one) nor the bias of a single strong buried object, at most
+    starting value. When the hologram records a ``polarization`` and the source
+    has one (a :class:`~holoradar.Dipole`, a polarised horn or beam), the glare
+    and the direct wave are the vector fields, TE and TM waves each reflected
+    with their own law; otherwise the scalar (TE) model. The 1-sigma covers
+    receiver noise and diffuse clutter (a sandwich estimate); it does not cover
+    model error (a vector source seen as a scalar one) nor the bias of a single
+    strong buried object, at most
     ``4 n |V| e / (1 + V)^2`` for an object ``e`` times weaker than the glare.
 
     Examples
@@ -40,8 +45,8 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     4.0
     """
     src = source if source is not None else getattr(hologram, "source", None)
-    if direct and isinstance(src, PointSource | GaussianBeam):
-        D = _direct_wave(src, hologram.k, hologram.points)
+    if direct and isinstance(src, PointSource | GaussianBeam | Dipole):
+        D = _direct_wave(src, hologram.k, hologram.points, _recorded(hologram, src))
         h = hologram.data.ravel()
         share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)
         if share < 0.01:

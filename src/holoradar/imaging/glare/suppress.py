@@ -18,10 +18,11 @@ import scipy.fft as sfft
 
 from ...analysis.theory import lateral_resolution
 from ...data.hologram import Hologram
+from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.propagation import AngularSpectrum
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _direct_wave, _joint_direct
+from ._common import _direct_wave, _joint_direct, _recorded
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source
 
@@ -133,12 +134,12 @@ def _check(hologram: Hologram, medium: Medium, source: object, method: str) -> N
     if method not in ("gaussian", "cut", "image_source", "background"):
         raise ValueError("method must be 'gaussian', 'cut', 'image_source' or 'background', "
                          f"got {method!r}")
-    if method != "background" and not isinstance(source, PointSource | GaussianBeam):
-        raise ValueError(f"method {method!r} needs the radiator as a PointSource or a "
-                         "GaussianBeam (its mirror image focuses); for a plane wave the glare "
+    if method != "background" and not isinstance(source, PointSource | GaussianBeam | Dipole):
+        raise ValueError(f"method {method!r} needs the radiator as a PointSource, a Dipole or "
+                         "a GaussianBeam (its mirror image focuses); for a plane wave the glare "
                          "is a plane wave: use method='background'")
     z0 = medium.z_interfaces[0]
-    if method != "background" and isinstance(source, PointSource) \
+    if method != "background" and isinstance(source, PointSource | Dipole) \
             and float(source.position[2]) >= z0:
         raise ValueError(f"source range {float(source.position[2])} m must lie above the "
                          f"ground surface ({z0} m)")
@@ -282,7 +283,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     predicted = mirror_local[:2]
     E_before = _mirror_image(op, data)
     xs, ys, peak_before = _find_spot(hologram, op, E_before, predicted, 3 * cell)
-    D = _direct_wave(src, k, pts) if direct else None
+    pol = _recorded(hologram, src)
+    D = _direct_wave(src, k, pts, pol) if direct else None
     h = data.ravel()
     report_kw: dict[str, Any] = {"mirror_plane": z_m}
     if method == "cut":
@@ -339,7 +341,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     else:  # image_source
         glare, direct_part, dcoef, fit = _fit_image_source(
             k, medium, src, pts, h, D, reference_amplitude, initial,
-            lambda v: v.reshape(data.shape))
+            lambda v: v.reshape(data.shape), pol)
         report_kw.update(mirror_position=tuple(src.mirror_position(medium)),
                          amplitude=fit["a"], phase=float(np.angle(fit["a"])),
                          eps=fit["eps"], eps_std=fit["eps_std"])
@@ -354,7 +356,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         direct_removed_db=None if D is None else _db(float(np.sum(np.abs(direct_part) ** 2)),
                                                      left),
         direct_amplitude=dcoef, converged=converged, parameters=params)
-    if method == "gaussian" and isinstance(src, PointSource):
+    if method == "gaussian" and isinstance(src, PointSource | Dipole):
         # The radiator's amplitude: given, or the direct wave's when one was found (it
         # carries at least 1% of the hologram's energy), else the source's own.
         ref = reference_amplitude
