@@ -36,6 +36,26 @@ HOLOGRAMS = {
                          pose=hr.Pose((0.01, -0.2, 0.05), tilt=0.6, azimuth=1.2)),
     "gaussian-beam": hr.Hologram(_rand((4, 5)), X, Y, F0,
                                  source=hr.GaussianBeam(0.05, (0.0, 0.01, -0.3), 0.1, 0.0)),
+    # The vector model: the recorded component (world axes) and polarised sources.
+    "dipole": hr.Hologram(_rand((2, 4, 5)), X, Y, [9e9, 11e9],
+                          source=hr.Dipole((-0.2, 0.01, 0.2), moment=(0.3, 1 + 0.5j, -0.1j),
+                                           amplitude=2 - 1j),
+                          polarization=(0.1, 1.0, 0.2)),
+    "plane-polarised": hr.Hologram(_rand((4, 5)), X, Y, F0,
+                                   source=hr.PlaneWave(0.1, -0.2, polarization=(0.3, 1, 0.1)),
+                                   polarization=(1.0, 0.3, 0.0)),
+    "point-polarised": hr.Hologram(_rand((4, 5)), X, Y, F0,
+                                   source=hr.PointSource((0.0, -0.25, 0.0), pattern_exponent=2,
+                                                         axis=(0, 0.5, 1), amplitude=0.5 + 1j,
+                                                         polarization=(0.2, 1.0, 0.3)),
+                                   pose=hr.Pose((0.01, -0.2, 0.05), tilt=0.6, azimuth=1.2),
+                                   polarization=(0.0, 0.6, 0.8)),
+    "gaussian-polarised": hr.Hologram(_rand((4, 5), np.complex64), X, Y, F0,
+                                      source=hr.GaussianBeam(0.05, (0.0, 0.01, -0.3), 0.1, 0.0,
+                                                             polarization=(1, 1, 0.3)),
+                                      polarization=(0, 1, 0)),
+    "monostatic-polarised": hr.Hologram(_rand((4, 5)), X, Y, F0, monostatic=True,
+                                        polarization=(1.0, 0.0, 0.0)),
 }
 IMAGES = {
     "plane": hr.Image(_rand((4, 5)), X, Y, np.array([0.4]), F0, "angular", has_z_axis=False),
@@ -57,6 +77,19 @@ def _same(a, b):
     if isinstance(a, hr.Hologram):
         assert a.pose == b.pose and a.monostatic == b.monostatic
         assert source_to_json(a.source) == source_to_json(b.source)
+        assert type(a.source) is type(b.source)
+        if a.polarization is None:
+            assert b.polarization is None
+        else:  # the recorded component, bit for bit, read-only like the original
+            assert b.polarization is not None and not b.polarization.flags.writeable
+            np.testing.assert_array_equal(a.polarization, b.polarization)
+        if isinstance(a.source, hr.Dipole):
+            np.testing.assert_array_equal(a.source.position, b.source.position)
+            np.testing.assert_array_equal(a.source.moment, b.source.moment)
+            assert a.source.moment.dtype == b.source.moment.dtype == complex
+            assert a.source.amplitude == b.source.amplitude
+        elif a.source is not None:
+            assert a.source.polarization == b.source.polarization
     else:
         np.testing.assert_array_equal(a.z, b.z)
         assert a.method == b.method and a.has_z_axis == b.has_z_axis
@@ -73,6 +106,65 @@ def test_save_then_load_gives_back_an_equal_object(name, tmp_path):
     _same(obj, read_direct(path))
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         _same(obj, from_dataset(ds.load()))
+
+
+def test_polarised_sources_come_back_polarised(tmp_path):
+    """Each kind of polarised source is stored with its polarisation and comes back a vector
+    source (the hologram's ``is_vector`` holds), through both readers."""
+    import xarray as xr
+
+    for name in ("dipole", "plane-polarised", "point-polarised", "gaussian-polarised"):
+        h = HOLOGRAMS[name]
+        path = hr.save(h, tmp_path / f"{name}.nc")
+        for back in (hr.load(path), read_direct(path)):
+            assert back.is_vector and back.source.polarization is not None
+            np.testing.assert_array_equal(np.asarray(back.source.polarization),
+                                          np.asarray(h.source.polarization))
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            back = from_dataset(ds.load())
+        assert back.is_vector
+
+
+def test_polarization_is_a_unit_vector_attribute_and_old_files_load_without_it(tmp_path):
+    """The recorded component is the global attribute ``polarization`` (a unit vector, world
+    axes); a file without it (written before the vector model) loads as a scalar hologram."""
+    import xarray as xr
+
+    h = HOLOGRAMS["point-polarised"]
+    path = hr.save(h, tmp_path / "vector.nc")
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        ds = ds.load()
+    np.testing.assert_allclose(ds.attrs["polarization"], [0.0, 0.6, 0.8], atol=1e-15)
+    assert '"polarization": [' in ds.attrs["source"]
+    # An old-style file: the same hologram, its scalar source, and no polarization attribute.
+    del ds.attrs["polarization"]
+    ds.attrs["source"] = source_to_json(hr.PointSource((0.0, -0.25, 0.0), pattern_exponent=2,
+                                                       axis=(0, 0.5, 1)))
+    old = tmp_path / "old.nc"
+    ds.to_netcdf(old, engine="h5netcdf")
+    with xr.open_dataset(old, engine="h5netcdf") as ds_old:
+        via_xarray = from_dataset(ds_old.load())
+    for back in (hr.load(old), read_direct(old), via_xarray):
+        assert back.polarization is None and back.source.polarization is None
+        assert not back.is_vector and back.pose == h.pose
+        assert np.array_equal(back.data, h.data)
+
+
+@pytest.mark.parametrize("value", ["up", [0.0, 1.0], [0.0, 0.0, 0.0], [0.0, 2.0, 0.0],
+                                   [np.nan, 1.0, 0.0]])
+def test_a_bad_polarization_attribute_is_one_clear_error(tmp_path, value):
+    import xarray as xr
+
+    with xr.open_dataset(hr.save(HOLOGRAMS["dipole"], tmp_path / "h.nc"),
+                         engine="h5netcdf") as ds:
+        ds = ds.load()
+    ds.attrs["polarization"] = value
+    bad = tmp_path / "bad.nc"
+    ds.to_netcdf(bad, engine="h5netcdf")
+    with pytest.raises(ValueError, match=r"bad\.nc.*'polarization' attribute must be a unit"):
+        hr.load(bad)
+    with pytest.raises(ValueError, match="'polarization' attribute"):
+        read_direct(bad)
 
 
 def test_file_is_plain_netcdf_with_cf_units(tmp_path):
@@ -184,7 +276,7 @@ def test_fuzzed_files_fail_cleanly_and_stay_untouched(tmp_path, data):
         with xr.open_dataset(base, engine="h5netcdf") as ds:
             ds = ds.load()
         key = data.draw(st.sampled_from(["source", "pose_center_m", "wideband", "monostatic",
-                                         "holoradar_kind", "history"]))
+                                         "holoradar_kind", "history", "polarization"]))
         # (HDF5 attributes cannot hold a NUL character: the writer would refuse it)
         text = st.text(st.characters(blacklist_characters="\x00"), max_size=20)
         ds.attrs[key] = data.draw(st.one_of(text, st.integers(-5, 5),

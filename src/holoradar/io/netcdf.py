@@ -17,7 +17,18 @@ Layout of a file:
   the pose (``pose_center_m``, ``pose_tilt_rad``, ``pose_azimuth_rad``), the
   source as JSON (``source``), the image's ``method`` and ``has_z_axis``, and a
   processing ``history`` (JSON list of steps: name, parameters, holoradar's
-  version, UTC time).
+  version, UTC time);
+* ``polarization`` (a hologram that records one field component): three numbers,
+  the unit vector (x, y, z) in world axes (the medium's frame, not the aperture's
+  own) of the electric-field component the elements record, e.g. ``[0, 1, 0]``
+  for E_y. Absent: the scalar model (``Hologram.polarization`` is None), as in
+  every file written before the vector model.
+
+The ``source`` JSON holds ``type`` (``PlaneWave``, ``PointSource``,
+``GaussianBeam`` or ``Dipole``) and the source's fields: numbers, lists of three
+numbers (positions, axes, a source's own ``polarization``: a unit vector in world
+axes, or null), complex numbers as ``{"re": ..., "im": ...}`` (``amplitude``, and
+each of a ``Dipole``'s three ``moment`` components).
 
 Reading parses numbers and JSON only: nothing is unpickled or evaluated.
 """
@@ -35,12 +46,13 @@ import numpy as np
 
 from ..data.hologram import Hologram, Image
 from ..data.pose import Pose
+from ..physics.dipole import Dipole
 from ..physics.sources import GaussianBeam, PlaneWave, PointSource
 
 __all__ = ["CONVENTIONS", "from_dataset", "read_history", "to_dataset"]
 
 CONVENTIONS = "1"
-_SOURCES = {cls.__name__: cls for cls in (PlaneWave, PointSource, GaussianBeam)}
+_SOURCES = {cls.__name__: cls for cls in (PlaneWave, PointSource, GaussianBeam, Dipole)}
 
 
 def _version() -> str:
@@ -73,8 +85,26 @@ def source_to_json(source: Any) -> str | None:
     return json.dumps({"type": type(source).__name__, **fields})
 
 
+def _from_jsonable(v: Any) -> Any:
+    """Undo :func:`_jsonable`'s complex numbers (``{"re", "im"}``), in lists too."""
+    if isinstance(v, dict) and set(v) == {"re", "im"}:
+        return complex(v["re"], v["im"])
+    if isinstance(v, list):
+        return [_from_jsonable(e) for e in v]
+    return v
+
+
 def source_from_json(text: str) -> Any:
-    """Rebuild a source from :func:`source_to_json`'s text (known types only)."""
+    """Rebuild a source from :func:`source_to_json`'s text (known types only).
+
+    Examples
+    --------
+    >>> d = source_from_json(source_to_json(Dipole((-0.2, 0, 0.2), moment=(0, 1j, 0))))
+    >>> d.moment.tolist(), d.amplitude
+    ([0j, 1j, 0j], (1+0j))
+    >>> source_from_json(source_to_json(PlaneWave(polarization=(0, 1, 0)))).polarization
+    (0.0, 1.0, 0.0)
+    """
     try:
         spec = json.loads(text)
         cls = _SOURCES[spec.pop("type")]
@@ -83,19 +113,21 @@ def source_from_json(text: str) -> Any:
         for k, v in spec.items():
             if k not in names:
                 raise KeyError(k)
-            if isinstance(v, dict) and set(v) == {"re", "im"}:
-                v = complex(v["re"], v["im"])
-            kw[k] = v
+            kw[k] = _from_jsonable(v)
         out = cls(**kw)
-        for k in ("axis", "position", "center"):
+        for k in ("axis", "position", "center", "polarization"):
             # Stored exactly as the source held them (already normalised): set them
             # back bit for bit, after the constructor has validated them.
-            if k in kw and hasattr(out, k):
+            if kw.get(k) is not None and hasattr(out, k):
                 stored = np.asarray(kw[k], float)
                 if stored.shape != np.shape(getattr(out, k)) or not np.allclose(
                         stored, getattr(out, k), rtol=1e-12, atol=1e-15):
                     raise ValueError(f"{k} {kw[k]!r} is not in normal form")
-                object.__setattr__(out, k, stored)
+                if isinstance(getattr(out, k), tuple):  # a source's polarization
+                    object.__setattr__(out, k, tuple(float(e) for e in stored))
+                else:
+                    stored.setflags(write=getattr(out, k).flags.writeable)
+                    object.__setattr__(out, k, stored)
         return out
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise ValueError(f"the file's 'source' attribute is not a holoradar source: {exc}; "
@@ -151,6 +183,8 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
         src = source_to_json(obj.source)
         if src is not None:
             attrs["source"] = src
+        if obj.polarization is not None:
+            attrs["polarization"] = np.asarray(obj.polarization, float)
         long_name = "received field at the elements"
     elif isinstance(obj, Image):
         kind, var = "Image", "image"
@@ -173,6 +207,22 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
                          {"long_name": long_name, "units": "1"})
     return xr.Dataset({var: values}, coords=coords, attrs=attrs)
+
+
+def _polarization(value: Any, what: str) -> np.ndarray | None:
+    """The ``polarization`` attribute: None when absent (the scalar model), else a unit
+    vector of three numbers."""
+    if value is None:
+        return None
+    try:
+        pol = np.array(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        pol = np.empty(0)
+    if pol.size != 3 or not np.all(np.isfinite(pol)) or \
+            not abs(float(np.linalg.norm(pol)) - 1) < 1e-6:
+        raise ValueError(f"{what}: the 'polarization' attribute must be a unit vector of 3 "
+                         f"numbers (x, y, z in world axes), got {value!r}")
+    return pol
 
 
 def _need(ds: Any, names: list[str], what: str) -> None:
@@ -212,10 +262,15 @@ def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
         pose = Pose(tuple(float(c) for c in center), float(ds.attrs.get("pose_tilt_rad", 0.0)),
                     float(ds.attrs.get("pose_azimuth_rad", 0.0)))
         src = ds.attrs.get("source")
-        return Hologram(data, x, y, freq,
-                        source=None if src is None else source_from_json(str(src)),
-                        monostatic=bool(int(ds.attrs.get("monostatic", 0))),
-                        pose=None if pose.is_identity else pose)
+        pol = _polarization(ds.attrs.get("polarization"), what)
+        out = Hologram(data, x, y, freq,
+                       source=None if src is None else source_from_json(str(src)),
+                       monostatic=bool(int(ds.attrs.get("monostatic", 0))),
+                       pose=None if pose.is_identity else pose, polarization=pol)
+        if pol is not None and np.allclose(pol, out.polarization, rtol=0, atol=1e-12):
+            pol.setflags(write=False)  # the stored unit vector, bit for bit
+            object.__setattr__(out, "polarization", pol)
+        return out
     _need(ds, ["z"], what)
     has_z = bool(int(ds.attrs.get("has_z_axis", 1)))
     z = np.asarray(ds["z"].values, float).ravel()

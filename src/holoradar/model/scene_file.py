@@ -11,6 +11,8 @@ A scene file (all lengths in metres, frequencies in Hz, angles in degrees)::
     # center = [0.0, -0.15, 0.05]     # a posed (tilted) array: world centre,
     # tilt_deg = 35.0                 # tilt from level and
     # azimuth_deg = 90.0              # the azimuth of the tilt axis
+    # polarization = [0.0, 1.0, 0.0]  # the field component recorded (world axes):
+    #                                 # the vector model, with a polarised source
 
     [ground]                          # omit for free space
     surface = 0.30                    # range of the surface from the array plane
@@ -22,15 +24,26 @@ A scene file (all lengths in metres, frequencies in Hz, angles in degrees)::
     # eps = 5.0
 
     [source]                          # omit for a normal plane wave
-    type = "point"                    # "plane", "point" or "gaussian"
+    type = "point"                    # "plane", "point", "gaussian" or "dipole"
     position = [0.0, -0.25, 0.0]
     pattern_exponent = 20
     axis = [0.0, 0.5, 1.0]            # plane: alpha_deg, beta_deg; gaussian: waist, center
+    # polarization = [0.0, 1.0, 0.0]  # plane, point, gaussian: the field's direction
+    # a Hertzian dipole: type = "dipole", position, moment = [0, 1, 0] (complex
+    # components as numbers or strings, "0+1j"), amplitude (optional, complex)
 
     [[target]]
     type = "point"
     position = [0.0, 0.0, 0.42]
     amplitude = 1.0
+    # polarizability = 1e-3           # vector model: a number or a 3 x 3 list of lists
+
+    [[target]]
+    type = "line"                     # a rebar, pipe or wire (a perfect conductor)
+    start = [-0.15, 0.0, 0.35]
+    end = [0.15, 0.0, 0.35]
+    radius = 0.006
+    # eps = "1.0"                     # a dielectric cylinder (1.0: an air-filled void)
 
     [[target]]
     type = "shape"                    # a planar object (Kirchhoff)
@@ -64,11 +77,12 @@ import numpy as np
 
 from ..data.hologram import C0
 from ..data.pose import Pose
+from ..physics.dipole import Dipole
 from ..physics.medium import Medium, permittivity
 from ..physics.sources import GaussianBeam, PlaneWave, PointSource
 from . import shapes
 from .scene import Aperture, Scene
-from .targets import PlanarTarget, PointTarget
+from .targets import LineTarget, PlanarTarget, PointTarget
 
 __all__ = ["SceneSpec", "load_scene", "medium_from_mapping", "parse_complex",
            "scene_from_mapping"]
@@ -136,6 +150,61 @@ def _vector(m: Mapping[str, Any], key: str, where: str, n: int, default: Any = _
                        and math.isfinite(e) for e in v)):
         raise ValueError(f"{where}.{key} must be a list of {n} numbers, got {v!r}")
     return tuple(float(e) for e in v)
+
+
+def _direction(m: Mapping[str, Any], key: str, where: str) -> tuple[float, float, float] | None:
+    """An optional direction (a ``polarization``): three numbers, not all zero, returned
+    normalised; None when absent."""
+    if key not in m:
+        return None
+    v = m[key]
+    if (not isinstance(v, list) or len(v) != 3
+            or not all(isinstance(e, int | float) and not isinstance(e, bool)
+                       and math.isfinite(e) for e in v)):
+        raise ValueError(f"{where}.{key} must be a direction of 3 numbers [x, y, z] in the "
+                         f"scene's axes, e.g. [0, 1, 0] for a field along y, got {v!r}")
+    norm = math.hypot(*(float(e) for e in v))
+    if not norm > 0:
+        raise ValueError(f"{where}.{key} must not be zero: give the field's direction, e.g. "
+                         f"[0, 1, 0] for a field along y")
+    return tuple(float(e) / norm for e in v)  # (hypot: no underflow for tiny components)
+
+
+def _complex_list(v: Any, where: str, n: int) -> list[complex]:
+    if not isinstance(v, list) or len(v) != n:
+        raise ValueError(f"{where} must be a list of {n} numbers (complex ones as strings like "
+                         f"'0+1j'), got {v!r}")
+    out = [parse_complex(e, where) for e in v]
+    if not all(math.isfinite(e.real) and math.isfinite(e.imag) for e in out):
+        raise ValueError(f"{where} must hold finite numbers, got {v!r}")
+    return out
+
+
+def _moment(m: Mapping[str, Any], where: str) -> list[complex]:
+    if "moment" not in m:
+        raise ValueError(f"{where}: missing key 'moment' (the dipole moment [px, py, pz], "
+                         "e.g. [0, 1, 0] for a dipole along y)")
+    p = _complex_list(m["moment"], f"{where}.moment", 3)
+    if not any(p):
+        raise ValueError(f"{where}.moment must not be zero: a dipole without a moment radiates "
+                         "nothing (give its direction, e.g. [0, 1, 0])")
+    return p
+
+
+def _polarizability(m: Mapping[str, Any], where: str) -> Any:
+    """A point target's polarizability: a (complex) number, or a 3 x 3 list of lists."""
+    if "polarizability" not in m:
+        return None
+    v, w = m["polarizability"], f"{where}.polarizability"
+    if not isinstance(v, list):
+        a = parse_complex(v, w)
+        if not (math.isfinite(a.real) and math.isfinite(a.imag)):
+            raise ValueError(f"{w} must be finite, got {v!r}")
+        return a
+    if len(v) != 3 or not all(isinstance(row, list) and len(row) == 3 for row in v):
+        raise ValueError(f"{w} must be a number or a 3 x 3 tensor (a list of 3 rows of 3 "
+                         f"numbers, metres), got {v!r}")
+    return [_complex_list(row, w, 3) for row in v]
 
 
 def _bool(m: Mapping[str, Any], key: str, where: str, default: bool) -> bool:
@@ -210,40 +279,60 @@ def _source(m: Mapping[str, Any], where: str) -> Any:
         return PlaneWave()
     kind = m.get("type", "plane")
     if kind == "plane":
-        _unknown(m, {"type", "alpha_deg", "beta_deg"}, where)
+        _unknown(m, {"type", "alpha_deg", "beta_deg", "polarization"}, where)
         return PlaneWave(math.radians(_number(m, "alpha_deg", where, 0.0)),
-                         math.radians(_number(m, "beta_deg", where, 0.0)))
+                         math.radians(_number(m, "beta_deg", where, 0.0)),
+                         polarization=_direction(m, "polarization", where))
     if kind == "point":
-        _unknown(m, {"type", "position", "pattern_exponent", "axis", "amplitude", "dipole"},
-                 where)
+        _unknown(m, {"type", "position", "pattern_exponent", "axis", "amplitude", "dipole",
+                     "polarization"}, where)
+        pol = _direction(m, "polarization", where)
+        if pol is not None and m.get("dipole") is True:
+            raise ValueError(f"{where}: give either dipole = true (the scalar stand-in for a "
+                             "dipole) or polarization (the vector horn), not both; or use "
+                             "type = \"dipole\"")
         return PointSource(_vector(m, "position", where, 3),
                            pattern_exponent=float(_number(m, "pattern_exponent", where, 0.0,
                                                           minimum=0.0)),
                            axis=_vector(m, "axis", where, 3, (0.0, 0.0, 1.0)),
                            amplitude=parse_complex(m.get("amplitude", 1.0), f"{where}.amplitude"),
-                           dipole=_bool(m, "dipole", where, False))
+                           dipole=_bool(m, "dipole", where, False), polarization=pol)
     if kind == "gaussian":
-        _unknown(m, {"type", "waist", "center", "alpha_deg", "beta_deg", "amplitude"}, where)
+        _unknown(m, {"type", "waist", "center", "alpha_deg", "beta_deg", "amplitude",
+                     "polarization"}, where)
         return GaussianBeam(float(_number(m, "waist", where, positive=True, unit="m")),
                             center=_vector(m, "center", where, 3, (0.0, 0.0, 0.0)),
                             alpha=math.radians(_number(m, "alpha_deg", where, 0.0)),
                             beta=math.radians(_number(m, "beta_deg", where, 0.0)),
                             amplitude=parse_complex(m.get("amplitude", 1.0),
-                                                    f"{where}.amplitude"))
-    raise ValueError(f"{where}.type must be 'plane', 'point' or 'gaussian', got {kind!r}")
+                                                    f"{where}.amplitude"),
+                            polarization=_direction(m, "polarization", where))
+    if kind == "dipole":
+        _unknown(m, {"type", "position", "moment", "amplitude"}, where)
+        return Dipole(_vector(m, "position", where, 3), moment=_moment(m, where),
+                      amplitude=parse_complex(m.get("amplitude", 1.0), f"{where}.amplitude"))
+    raise ValueError(f"{where}.type must be 'plane', 'point', 'gaussian' or 'dipole', got "
+                     f"{kind!r}")
 
 
-def _targets(items: Any, where: str) -> list[PointTarget | PlanarTarget]:
+def _targets(items: Any, where: str) -> list[PointTarget | LineTarget | PlanarTarget]:
     if not isinstance(items, list) or not all(isinstance(t, Mapping) for t in items):
         raise ValueError(f"{where} must be a list of tables [[target]]")
-    out: list[PointTarget | PlanarTarget] = []
+    out: list[PointTarget | LineTarget | PlanarTarget] = []
     for i, t in enumerate(items):
         w = f"{where}[{i}]"
         kind = t.get("type", "point")
         if kind == "point":
-            _unknown(t, {"type", "position", "amplitude"}, w)
-            out.append(PointTarget(_vector(t, "position", w, 3),
-                                   parse_complex(t.get("amplitude", 1.0), f"{w}.amplitude")))
+            _unknown(t, {"type", "position", "amplitude", "polarizability"}, w)
+            out.append(_within(w, PointTarget, _vector(t, "position", w, 3),
+                               parse_complex(t.get("amplitude", 1.0), f"{w}.amplitude"),
+                               _polarizability(t, w)))
+        elif kind == "line":
+            _unknown(t, {"type", "start", "end", "radius", "eps"}, w)
+            eps = parse_complex(t["eps"], f"{w}.eps") if "eps" in t else None
+            out.append(_within(w, LineTarget, _vector(t, "start", w, 3),
+                               _vector(t, "end", w, 3),
+                               float(_number(t, "radius", w, positive=True, unit="m")), eps))
         elif kind == "shape":
             name = t.get("shape")
             if name not in shapes.__all__:
@@ -262,13 +351,13 @@ def _targets(items: Any, where: str) -> list[PointTarget | PlanarTarget]:
                 reflection=parse_complex(t.get("reflection", 1.0), f"{w}.reflection"),
                 pixel=float(_number(t, "pixel", w, 0.002, positive=True, unit="m")), **sizes))
         else:
-            raise ValueError(f"{w}.type must be 'point' or 'shape', got {kind!r}")
+            raise ValueError(f"{w}.type must be 'point', 'line' or 'shape', got {kind!r}")
     return out
 
 
 def _aperture(m: Mapping[str, Any], where: str) -> Aperture:
     _unknown(m, {"n", "ny", "pitch", "pitch_y", "monostatic", "center", "tilt_deg",
-                 "azimuth_deg"}, where)
+                 "azimuth_deg", "polarization"}, where)
     n = int(_number(m, "n", where, integer=True))
     ny = int(_number(m, "ny", where, n, integer=True))
     for key, v in (("n", n), ("ny", ny)):
@@ -281,8 +370,17 @@ def _aperture(m: Mapping[str, Any], where: str) -> Aperture:
         pose = Pose(_vector(m, "center", where, 3, (0.0, 0.0, 0.0)),
                     tilt=math.radians(_number(m, "tilt_deg", where, 0.0)),
                     azimuth=math.radians(_number(m, "azimuth_deg", where, 0.0)))
+    pol = _direction(m, "polarization", where)
+    if pol is not None:
+        normal = (pose or Pose()).normal
+        if abs(float(np.dot(pol, normal))) > 1 - 1e-9:
+            raise ValueError(f"{where}.polarization {m['polarization']!r} lies along the "
+                             f"array's line of sight (its normal "
+                             f"{np.round(normal, 6).tolist()}): the elements would record "
+                             "nothing; give a component across the array, e.g. [0, 1, 0]")
     return Aperture.grid(n, pitch, ny=ny, pitch_y=pitch_y,
-                         monostatic=_bool(m, "monostatic", where, False), pose=pose)
+                         monostatic=_bool(m, "monostatic", where, False), pose=pose,
+                         polarization=pol)
 
 
 def _within(where: str, build: Any, *args: Any) -> Any:

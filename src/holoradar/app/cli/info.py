@@ -42,6 +42,8 @@ def describe(obj: Any) -> dict[str, Any]:
                      "center_m": list(obj.pose.center), "tilt_deg":
                      float(np.degrees(obj.pose.tilt)),
                      "azimuth_deg": float(np.degrees(obj.pose.azimuth))},
+                 polarization=None if obj.polarization is None
+                 else [float(v) for v in obj.polarization],
                  problems=plausibility_problems(obj))
     else:
         d.update(z_m=np.asarray(obj.z, float).tolist(), method=obj.method)
@@ -94,7 +96,10 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
     if d["kind"] == "Hologram":
         rows += [("pitch (mm)", f"{d['pitch_m'][0] * 1e3:.4g} x {d['pitch_m'][1] * 1e3:.4g}"),
                  ("monostatic", str(d["monostatic"])), ("source", str(d["source"])),
-                 ("pose", str(d["pose"]))]
+                 ("pose", str(d["pose"])),
+                 ("polarization", "none (scalar model)" if d["polarization"] is None else
+                  "E along (" + ", ".join(f"{v + 0.0:.4g}" for v in d["polarization"])
+                  + ") (world axes)")]
     else:
         rows += [("z (m)", _span(np.asarray(d["z_m"]))), ("method", d["method"])]
     rows.append(("max |value|", f"{d['max_amplitude']:.4g}"))
