@@ -28,6 +28,16 @@ radial grid (lambda/16 in the air), with one quadrature shared by all ranges
 4 x 4-point (bicubic Lagrange) interpolation of its amplitude and unwrapped
 phase (both smooth on the scale of the wavelength): moving the object costs no
 new integral. A point source's incident field is interpolated the same way.
+
+Vector model (a hologram that records a ``polarization`` u, lit by a polarised
+source): the scatterer is an isotropic induced dipole (a sphere), and the
+element records ``u . G(e <- r) a E0(r) = a (G(r <- e) u) . E0(r)`` by
+reciprocity, ``G`` the dyadic Green's function (:mod:`holoradar.physics.dyadic`);
+a scanned transceiver along u records ``a v . v`` with ``v = G(r <- e) u``. The
+incident field's direction now matters at one frequency too. The five radial
+functions of ``G`` are tabulated on the same (range, rho) windows and
+interpolated after removing the phase of the first (their common propagation
+phase).
 """
 
 from __future__ import annotations
@@ -38,9 +48,17 @@ from typing import Any
 import numpy as np
 
 from ..data.hologram import C0, Hologram
+from ..physics.dipole import Dipole
+from ..physics.dyadic import (
+    buried_dipole_dyadic,
+    dyadic_from_profiles,
+    dyadic_profiles,
+    dyadic_times,
+)
 from ..physics.green import layered_green, transmitted_profiles
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave, PointSource, ray_direction
+from ..physics.vector_waves import vector_transfer
 
 __all__ = ["PointResponse"]
 
@@ -101,8 +119,12 @@ class PointResponse:
         lo, hi = self.points[:, :2].min(axis=0), self.points[:, :2].max(axis=0)
         self.bounds = (lo - self.LATERAL_MARGIN, hi + self.LATERAL_MARGIN)
         self._rho_max = float(np.hypot(*(hi - lo))) + 2 * self.LATERAL_MARGIN
+        self.vector = bool(hologram.is_vector)
+        self.pol = np.asarray(hologram.polarization) if self.vector else None
         self.needs_e0 = (not self.monostatic and self.coherent and len(self.ks) > 1)
-        self._point_source = (self.needs_e0 and isinstance(self.source, PointSource)
+        if self.vector and not self.monostatic:
+            self.needs_e0 = True  # the incident field's direction matters at one frequency
+        self._point_source = (self.needs_e0 and isinstance(self.source, PointSource | Dipole)
                               and self.flat)
         if self._point_source:
             s = self.source.position
@@ -168,15 +190,24 @@ class PointResponse:
         n_lat = 1.0 if gap > 2 * np.pi / self.ks.min() else np.sqrt(max(eps, 1.0))
         rstep = 2 * np.pi / (self.ks.max() * n_lat) / _RHO_STEPS
         grid = np.arange(0.0, self._rho_max + 3 * rstep, rstep)
-        G = _Grid(zs, grid, np.stack([transmitted_profiles(float(k), medium, self.z_el, zs, grid)
-                                      for k in self.ks]))
+        if self.vector:
+            G = _VGrid(zs, grid, np.stack([dyadic_profiles(float(k), medium, self.z_el, zs, grid)
+                                           for k in self.ks]))
+        else:
+            G = _Grid(zs, grid, np.stack([transmitted_profiles(float(k), medium, self.z_el, zs,
+                                                               grid) for k in self.ks]))
         E = None
-        if self._point_source:
+        if self._point_source and self.vector:
+            s = self.source.position
+            sgrid = np.arange(0.0, self._rho_max_src + 3 * rstep, rstep)
+            E = _VGrid(zs, sgrid, np.stack([dyadic_profiles(float(k), medium, float(s[2]), zs,
+                                                            sgrid) for k in self.ks]))
+        elif self._point_source:
             s = self.source.position
             sgrid = np.arange(0.0, self._rho_max_src + 3 * rstep, rstep)
             E = _Grid(zs, sgrid, np.stack([transmitted_profiles(float(k), medium, float(s[2]),
                                                                 zs, sgrid) for k in self.ks]))
-        elif self.needs_e0 and isinstance(self.source, PlaneWave):
+        elif self.needs_e0 and isinstance(self.source, PlaneWave) and not self.vector:
             # A plane wave: exp(i(p0 x + q0 y)) times a transfer that depends on range only.
             E = np.stack([self.source.field(float(k), medium,
                                             np.c_[np.zeros((zs.size, 2)), zs]) for k in self.ks])
@@ -190,6 +221,8 @@ class PointResponse:
         eps, z = float(eps), float(z)
         self.responses += 1
         pos = np.array([[xy[0], xy[1], z]])
+        if self.vector:
+            return self._vector_response(eps, z, xy, pos, window)
         if self.flat:
             w = window or self._window(eps, z)
             rho = np.hypot(self.points[:, 0] - xy[0], self.points[:, 1] - xy[1])
@@ -216,6 +249,49 @@ class PointResponse:
         else:
             E0 = np.array([self.source.field(float(k), medium, pos)[0] for k in self.ks])
         return G * E0[:, None]
+
+    def _vector_response(self, eps: float, z: float, xy: Any, pos: np.ndarray,
+                         window: _Window | None) -> np.ndarray:
+        """``u . G(e <- r) E0(r)`` (or ``v . v``, monostatic) at the elements, (nf, N)."""
+        if self.flat:
+            w = window or self._window(eps, z)
+            off = np.c_[xy[0] - self.points[:, 0], xy[1] - self.points[:, 1]]
+            v = dyadic_times(off, w.G(z, np.hypot(off[:, 0], off[:, 1])), self.pol)
+            medium = w.medium
+        else:
+            medium = self.make_medium(eps)
+            v = np.stack([np.swapaxes(buried_dipole_dyadic(float(k), medium, pos[0],
+                                                           self.points), 1, 2) @ self.pol
+                          for k in self.ks])
+            self.integrals += len(self.ks)
+            w = None
+        # v = G(r <- e) u, (nf, N, 3)
+        if self.monostatic:
+            return np.einsum("fni,fni->fn", v, v)
+        return np.einsum("fni,fi->fn", v, self._incident_vector(medium, pos, xy, z, w))
+
+    def _incident_vector(self, medium: Medium, pos: np.ndarray, xy: Any, z: float,
+                         w: _Window | None) -> np.ndarray:
+        """The incident field vector at the object, (nf, 3)."""
+        s = self.source
+        if w is not None and self._point_source:
+            off = np.array([[xy[0] - s.position[0], xy[1] - s.position[1]]])
+            moment = (s.moment if isinstance(s, Dipole) else np.asarray(s.polarization))
+            prof = w.E(z, np.hypot(off[:, 0], off[:, 1]))
+            E = s.amplitude * (dyadic_from_profiles(off, prof)[:, 0] @ moment)
+            if isinstance(s, PointSource) and s.pattern_exponent:
+                E = E * np.array([s.pattern(ray_direction(float(k), medium, s.position,
+                                                          pos))[0] for k in self.ks])[:, None]
+            return E
+        if isinstance(s, PlaneWave):
+            p0, q0 = s.wavenumbers(1.0)
+            out = []
+            for k in self.ks:
+                v = vector_transfer(float(k), medium, np.array(p0 * k), np.array(q0 * k),
+                                    np.array(s.polarization), 0.0, z)
+                out.append(v * np.exp(1j * k * (p0 * xy[0] + q0 * xy[1])))
+            return np.array(out)
+        return np.stack([s.field_vector(float(k), medium, pos)[0] for k in self.ks])
 
     # ------------------------------------------------------------- matching
     def match(self, g: np.ndarray, *, phase: bool | None = None,
@@ -304,3 +380,34 @@ class _Grid:
             rows = np.tensordot(wz, table[:, iz - 1:iz + 3, :], axes=(0, 1))  # (nf, nrho)
             out.append(np.einsum("fnk,nk->fn", rows[:, idx], wr))
         return out[0] * np.exp(1j * out[1])
+
+
+class _VGrid:
+    """The five radial functions of the dyadic Green's function for all frequencies on a
+    uniform (range, rho) grid, values (nf, nz, 5, nrho); interpolated by 4 x 4-point
+    Lagrange interpolation of their real and imaginary parts after removing the
+    unwrapped phase of the first (which is interpolated too)."""
+
+    def __init__(self, zs: np.ndarray, rho: np.ndarray, values: np.ndarray) -> None:
+        phase = np.unwrap(np.angle(values[:, :, 0, :]), axis=2)
+        phase += (np.unwrap(phase[:, :, 0], axis=1) - phase[:, :, 0])[:, :, None]
+        # The demodulated values, and the phase appended as a sixth (real) row.
+        table = values * np.exp(-1j * phase)[:, :, None, :]
+        self.table = np.concatenate([table, phase[:, :, None, :].astype(complex)], axis=2)
+        self.z0, self.dz = float(zs[0]), float(zs[1] - zs[0])
+        self.r0, self.dr = float(rho[0]), float(rho[1] - rho[0])
+        self.nz, self.nr = zs.size, rho.size
+
+    def __call__(self, z: float, rho: np.ndarray) -> np.ndarray:
+        """Radial functions at range ``z`` and distances ``rho``: (nf, 5, len(rho))."""
+        u = (z - self.z0) / self.dz
+        iz = min(max(int(np.floor(u)), 1), self.nz - 3)
+        wz = _Grid._weights(np.array(u - iz))
+        v = (np.asarray(rho, float) - self.r0) / self.dr
+        ir = np.clip(np.floor(v).astype(int), 1, self.nr - 3)
+        wr = _Grid._weights(v - ir)                                   # (N, 4)
+        idx = ir[:, None] + np.arange(-1, 3)                          # (N, 4)
+        lo, hi = int(idx.min()), int(idx.max()) + 1       # only the columns in use
+        rows = np.tensordot(wz, self.table[:, iz - 1:iz + 3, :, lo:hi], axes=(0, 1))
+        vals = np.einsum("fcnk,nk->fcn", rows[:, :, idx - lo], wr)      # (nf, 6, N)
+        return vals[:, :5] * np.exp(1j * vals[:, 5].real)[:, None, :]

@@ -61,14 +61,16 @@ field are included. The direct wave in the air is the closed form above.
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 from scipy.special import j0, j1
 
 from .green import _nodes, _phase_length
 from .medium import Medium
 
-__all__ = ["RadialDyadic", "buried_dipole_dyadic", "free_space_dyadic", "reflected_dyadic",
-           "transmitted_dyadic"]
+__all__ = ["RadialDyadic", "buried_dipole_dyadic", "dyadic_from_profiles", "dyadic_profiles",
+           "dyadic_times", "free_space_dyadic", "reflected_dyadic", "transmitted_dyadic"]
 
 
 def free_space_dyadic(k: complex, src: np.ndarray, pts: np.ndarray) -> np.ndarray:
@@ -389,3 +391,136 @@ class RadialDyadic:
                              f"{self.rho[-1]:.4g} m")
         prof = (self._re(rho) + 1j * self._im(rho)) * np.exp(1j * self._phase(rho))
         return _build(off, prof)
+
+
+def _kernels_many(k: float, medium: Medium, kap: np.ndarray, z_src: float,
+                  z_obs: np.ndarray) -> np.ndarray:
+    """:func:`_transmitted_kernels` for many ground ranges, shape (nz, 5, nkappa).
+
+    Inside one region the down- and up-going parts only change by
+    ``exp(+-i kz (z - top))``: the stack is solved once per region, at its top.
+    """
+    k2 = kap**2
+    kz0 = medium.kz(k, k2, 0)
+    te, tm = medium.with_polarization("TE"), medium.with_polarization("TM")
+    e = kap / kz0
+    u, w = kz0 / k, kap / k
+    out = np.empty((z_obs.size, 5, kap.size), complex)
+    regions = np.atleast_1d(medium.region_of(z_obs))
+    for region in np.unique(regions):
+        sel = np.nonzero(regions == region)[0]
+        top = medium.top_of(int(region))
+        dh, uh = te.transfer_parts(k, k2, z_src, top)
+        dv, uv = tm.transfer_parts(k, k2, z_src, top)
+        kzm = medium.kz(k, k2, int(region))
+        ph = np.exp(1j * kzm * (z_obs[sel, None] - top))      # (nz, nkappa)
+        back = 1 / ph
+        tau_h = dh * ph + uh * back
+        tau_v = dv * ph + uv * back
+        sig_v = dv * ph - uv * back
+        ratio = kap / kzm
+        out[sel, 0] = 0.5j * e * (tau_h + tau_v * u * u)
+        out[sel, 1] = 0.5j * e * (tau_h - tau_v * u * u)
+        out[sel, 2] = e * tau_v * u * w
+        out[sel, 3] = e * sig_v * ratio * u * u
+        out[sel, 4] = 1j * e * sig_v * ratio * u * w
+    return out
+
+
+def _bessel_j12(rho: np.ndarray, kappa: np.ndarray, J0: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``J1`` and ``J2`` of ``rho kappa``, kept for reuse beside the scalar field's ``J0``."""
+    from .green import _J0_CACHE
+
+    digest = hashlib.blake2b(rho.tobytes() + b"|J12|" + kappa.tobytes(), digest_size=16).digest()
+
+    def make() -> np.ndarray:
+        x = np.outer(rho, kappa)
+        J1 = j1(x)
+        return np.stack([J1, _j2(x, J0, J1)])
+
+    J12 = _J0_CACHE.get(("J12", rho.shape, kappa.shape, digest), make)
+    return J12[0], J12[1]
+
+
+def dyadic_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarray,
+                    rho: np.ndarray) -> np.ndarray:
+    """The five radial functions (A, B, C, Z, D) of :func:`transmitted_dyadic` from a
+    dipole in the air at range ``z_src`` to ground ranges ``z_obs`` at distances ``rho``.
+
+    One quadrature (sized for the farthest range) and one set of Bessel matrices
+    (kept for reuse, as the scalar field's) serve every range, as
+    :func:`holoradar.physics.green.transmitted_profiles` does for the scalar
+    field. Returns shape ``(len(z_obs), 5, len(rho))``; ``G`` at an offset follows
+    from them as in the module notes (:func:`dyadic_from_profiles`).
+
+    Examples
+    --------
+    >>> m = Medium.half_space(0.3, 4.0)
+    >>> prof = dyadic_profiles(200.0, m, 0.0, np.array([0.35, 0.4]), np.array([0.0, 0.1]))
+    >>> G = transmitted_dyadic(200.0, m, np.zeros(3), np.array([[0.1, 0.0, 0.4]]))
+    >>> bool(np.isclose(prof[1, 0, 1] + prof[1, 1, 1], G[0, 0, 0]))   # xx = A + B at azimuth 0
+    True
+    """
+    from .green import _bessel_matrix
+
+    z_obs = np.atleast_1d(np.asarray(z_obs, float))
+    rho = np.asarray(rho, float)
+    if medium.region_of(float(z_src)) != 0 or np.any(np.asarray(medium.region_of(z_obs)) == 0):
+        raise ValueError("dyadic_profiles: the dipole must lie in the air and the ranges in "
+                         "the ground")
+    air_len = max(0.0, medium.z_interfaces[0] - float(z_src))
+    pieces = _nodes(k, medium, _phase_length(medium, float(z_src), float(z_obs.max())),
+                    float(rho.max(initial=0.0)), air_len)
+    out = np.zeros((z_obs.size, 5, rho.size), complex)
+    for kap, w in pieces:
+        J0 = _bessel_matrix(rho, kap)
+        J1, J2 = _bessel_j12(rho, kap, J0)
+        fw = _kernels_many(k, medium, kap, float(z_src), z_obs) * w   # (nz, 5, nkappa)
+        for i, J in ((0, J0), (1, J2), (2, J1), (3, J1), (4, J0)):
+            # Real matrix products: a complex @ real product would first copy J to complex.
+            out[:, i] += fw[:, i].real @ J.T + 1j * (fw[:, i].imag @ J.T)
+    return out
+
+
+def dyadic_times(offsets: np.ndarray, prof: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """``G @ u`` (..., N, 3) straight from the radial functions ``prof`` (..., 5, N) at
+    lateral ``offsets`` (N, 2), for one vector ``u`` (3,): without forming G.
+
+    Examples
+    --------
+    >>> prof = np.arange(10.0).reshape(5, 2) + 1j
+    >>> off = np.array([[0.1, 0.0], [0.0, 0.2]])
+    >>> u = np.array([0.2, 1.0, -0.5])
+    >>> bool(np.allclose(dyadic_times(off, prof, u), dyadic_from_profiles(off, prof) @ u))
+    True
+    """
+    off = np.atleast_2d(np.asarray(offsets, float))
+    a = np.arctan2(off[:, 1], off[:, 0])
+    c1, s1, c2, s2 = np.cos(a), np.sin(a), np.cos(2 * a), np.sin(2 * a)
+    A, B, C, Z, D = (prof[..., i, :] for i in range(5))
+    ux, uy, uz = (float(v) for v in u)
+    out = np.empty((*A.shape, 3), complex)
+    out[..., 0] = (A + B * c2) * ux + B * (s2 * uy) + C * (c1 * uz)
+    out[..., 1] = B * (s2 * ux) + (A - B * c2) * uy + C * (s1 * uz)
+    out[..., 2] = Z * (c1 * ux + s1 * uy) + D * uz
+    return out
+
+
+def dyadic_from_profiles(offsets: np.ndarray, prof: np.ndarray) -> np.ndarray:
+    """G (..., N, 3, 3) from radial functions ``prof`` (..., 5, N) at lateral ``offsets``
+    (N, 2) (observation minus source, metres)."""
+    off = np.atleast_2d(np.asarray(offsets, float))
+    a = np.arctan2(off[:, 1], off[:, 0])
+    c1, s1, c2, s2 = np.cos(a), np.sin(a), np.cos(2 * a), np.sin(2 * a)
+    A, B, C, Z, D = (prof[..., i, :] for i in range(5))
+    G = np.empty((*A.shape, 3, 3), complex)
+    G[..., 0, 0] = A + B * c2
+    G[..., 1, 1] = A - B * c2
+    G[..., 0, 1] = G[..., 1, 0] = B * s2
+    G[..., 0, 2] = C * c1
+    G[..., 1, 2] = C * s1
+    G[..., 2, 0] = Z * c1
+    G[..., 2, 1] = Z * s1
+    G[..., 2, 2] = D
+    return G

@@ -16,6 +16,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .dipole import Dipole
+from .dyadic import RadialDyadic
 from .green import free_space_green, layered_green, transmitted_profiles
 from .medium import Medium
 from .sources import GaussianBeam, PlaneWave, PointSource, ray_direction
@@ -55,9 +57,11 @@ def incident_on_plane(source: object, k: float, medium: Medium, x: np.ndarray, y
     if isinstance(source, PlaneWave | GaussianBeam):
         pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z)], axis=1)
         return source.field(k, medium, pts).reshape(X.shape)
+    if isinstance(source, Dipole):
+        return _dipole_on_plane(source, k, medium, X, Y, z)
     if not isinstance(source, PointSource):
-        raise ValueError(f"source must be a PlaneWave, PointSource or GaussianBeam, got "
-                         f"{type(source).__name__}")
+        raise ValueError(f"source must be a PlaneWave, PointSource, Dipole or GaussianBeam, "
+                         f"got {type(source).__name__}")
     source._check_air(medium)  # a radiator below the surface is refused, as elsewhere
     src = source.position
     rho = np.hypot(X - src[0], Y - src[1])
@@ -74,6 +78,20 @@ def incident_on_plane(source: object, k: float, medium: Medium, x: np.ndarray, y
         pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z)], axis=1)
         e0 = e0 * source.pattern(ray_direction(k, medium, src, pts)).reshape(X.shape)
     return e0
+
+
+def _dipole_on_plane(source: Dipole, k: float, medium: Medium, X: np.ndarray, Y: np.ndarray,
+                     z: float) -> np.ndarray:
+    """A dipole's field along its axis on a plane: the dyadic's radial table in the
+    ground (one Sommerfeld quadrature for the plane), the closed form in the air."""
+    source._check_air(medium)
+    off = np.stack([X.ravel() - source.position[0], Y.ravel() - source.position[1]], axis=1)
+    if medium.is_free_space or medium.region_of(float(z)) == 0:
+        pts = np.c_[X.ravel(), Y.ravel(), np.full(X.size, z)]
+        return source.field(k, medium, pts).reshape(X.shape)
+    rho_max = float(np.hypot(off[:, 0], off[:, 1]).max(initial=0.0))
+    G = RadialDyadic(k, medium, float(source.position[2]), float(z), rho_max)(off)
+    return (source.amplitude * (G @ source.moment) @ source.polarization).reshape(X.shape)
 
 
 def incident_on_planes(source: object, k: float, medium: Medium, x: np.ndarray, y: np.ndarray,
