@@ -64,7 +64,7 @@ from __future__ import annotations
 import hashlib
 
 import numpy as np
-from scipy.special import j0, j1
+from scipy.special import j1
 
 from .green import _nodes, _phase_length
 from .medium import Medium
@@ -108,15 +108,19 @@ def _j2(x: np.ndarray, J0: np.ndarray, J1: np.ndarray) -> np.ndarray:
 
 
 def _profiles(rho: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
-              reflected: bool, chunk: int = 2048) -> np.ndarray:
-    """The five radial functions (A, B, C, Z, D) at distances ``rho``: shape (5, N)."""
+              reflected: bool, chunk: int = 4096) -> np.ndarray:
+    """The five radial functions (A, B, C, Z, D) at distances ``rho``: shape (5, N).
+
+    The Bessel matrices are kept for reuse (a fit over trial permittivities meets the
+    same distances and the same propagating nodes again)."""
+    from .green import _bessel_matrix
+
     out = np.zeros((5, rho.size), complex)
     for c0 in range(0, rho.size, chunk):
-        r = rho[c0:c0 + chunk]
+        r = np.ascontiguousarray(rho[c0:c0 + chunk])
         for kap, w, (kA, kB, kC, kZ, kD) in quad:
-            x = np.outer(r, kap)
-            J0, J1 = j0(x), j1(x)
-            J2 = _j2(x, J0, J1)
+            J0 = _bessel_matrix(r, kap)
+            J1, J2 = _bessel_j12(r, kap, J0)
             out[0, c0:c0 + chunk] += J0 @ (w * kA)
             out[1, c0:c0 + chunk] += J2 @ (w * kB)
             out[2, c0:c0 + chunk] += J1 @ (w * kC)
@@ -126,6 +130,31 @@ def _profiles(rho: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
     if reflected:
         out[3] = -out[2]
     return out
+
+
+def _radial_grid(k: float, medium: Medium, rho_max: float) -> np.ndarray:
+    """Distances at a sixteenth of the shortest wavelength in the stack, to ``rho_max``."""
+    n_max = max(abs(medium.n(m)) for m in range(medium.n_regions))
+    step = 2 * np.pi / (k * n_max) / 16
+    return np.arange(0.0, float(rho_max) + 3 * step, step)
+
+
+def _spline_profiles(grid: np.ndarray, prof: np.ndarray):
+    """Interpolator of radial functions (5, n) given on ``grid``: cubic splines of their
+    real and imaginary parts after removing the unwrapped phase of the first (the
+    propagation phase all five share), which is splined too."""
+    from scipy.interpolate import CubicSpline
+
+    phase = np.unwrap(np.angle(prof[0]))
+    demod = prof * np.exp(-1j * phase)
+    sp_phase = CubicSpline(grid, phase)
+    sp_re = CubicSpline(grid, demod.real, axis=1)
+    sp_im = CubicSpline(grid, demod.imag, axis=1)
+
+    def at(rho: np.ndarray) -> np.ndarray:
+        return (sp_re(rho) + 1j * sp_im(rho)) * np.exp(1j * sp_phase(rho))
+
+    return at
 
 
 def _assemble(offsets: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
@@ -217,7 +246,13 @@ def reflected_dyadic(k: float, medium: Medium, src: np.ndarray, pts: np.ndarray,
         pieces = _nodes(k, medium, L + _phase_length(medium, z0, z0), rho_max, L)
         quad = [(kap, w, _reflected_kernels(k, medium, kap, L, coefficients))
                 for kap, w in pieces]
-        out[sel] = _assemble(off, quad, reflected=True)
+        grid = _radial_grid(k, medium, rho_max)
+        if sel.size > 2 * grid.size:
+            # Many points: the radial functions on a grid, then splines (error ~1e-7).
+            rho = np.hypot(off[:, 0], off[:, 1])
+            out[sel] = _build(off, _spline_profiles(grid, _profiles(grid, quad, True))(rho))
+        else:
+            out[sel] = _assemble(off, quad, reflected=True)
     return out
 
 
@@ -359,11 +394,7 @@ class RadialDyadic:
 
     def __init__(self, k: float, medium: Medium, z_src: float, z_obs: float, rho_max: float,
                  kind: str = "transmitted") -> None:
-        from scipy.interpolate import CubicSpline
-
-        n_max = max(abs(medium.n(m)) for m in range(medium.n_regions))
-        step = 2 * np.pi / (k * n_max) / 16
-        self.rho = np.arange(0.0, float(rho_max) + 3 * step, step)
+        self.rho = _radial_grid(k, medium, rho_max)
         z0 = medium.z_interfaces[0] if not medium.is_free_space else np.inf
         if kind == "reflected":
             L = (z0 - z_src) + (z0 - z_obs)
@@ -375,12 +406,7 @@ class RadialDyadic:
                             air_len)
             quad = [(kap, w, _transmitted_kernels(k, medium, kap, z_src, z_obs))
                     for kap, w in pieces]
-        prof = _profiles(self.rho, quad, kind == "reflected")
-        phase = np.unwrap(np.angle(prof[0]))
-        demod = prof * np.exp(-1j * phase)
-        self._phase = CubicSpline(self.rho, phase)
-        self._re = CubicSpline(self.rho, demod.real, axis=1)
-        self._im = CubicSpline(self.rho, demod.imag, axis=1)
+        self._at = _spline_profiles(self.rho, _profiles(self.rho, quad, kind == "reflected"))
 
     def __call__(self, offsets: np.ndarray) -> np.ndarray:
         """G (N, 3, 3) at lateral ``offsets`` (N, 2) = observation - source, metres."""
@@ -389,8 +415,7 @@ class RadialDyadic:
         if rho.size and rho.max() > self.rho[-1]:
             raise ValueError(f"RadialDyadic: offset {rho.max():.4g} m beyond the table's "
                              f"{self.rho[-1]:.4g} m")
-        prof = (self._re(rho) + 1j * self._im(rho)) * np.exp(1j * self._phase(rho))
-        return _build(off, prof)
+        return _build(off, self._at(rho))
 
 
 def _kernels_many(k: float, medium: Medium, kap: np.ndarray, z_src: float,
@@ -477,9 +502,17 @@ def dyadic_profiles(k: float, medium: Medium, z_src: float, z_obs: np.ndarray,
         J0 = _bessel_matrix(rho, kap)
         J1, J2 = _bessel_j12(rho, kap, J0)
         fw = _kernels_many(k, medium, kap, float(z_src), z_obs) * w   # (nz, 5, nkappa)
-        for i, J in ((0, J0), (1, J2), (2, J1), (3, J1), (4, J0)):
-            # Real matrix products: a complex @ real product would first copy J to complex.
-            out[:, i] += fw[:, i].real @ J.T + 1j * (fw[:, i].imag @ J.T)
+        nz = z_obs.size
+        for J, rows in ((J0, (0, 4)), (J1, (2, 3)), (J2, (1,))):
+            # One real BLAS product per Bessel matrix for all ranges and kernels that use
+            # it (real and imaginary parts side by side, contiguous): a complex @ real
+            # product would copy J to complex, and strided real views miss BLAS.
+            cols = np.concatenate([fw[:, r].real for r in rows] + [fw[:, r].imag for r in rows])
+            prod = J @ np.ascontiguousarray(cols.T)                  # (nrho, 2 * len * nz)
+            half = len(rows) * nz
+            for j, r in enumerate(rows):
+                out[:, r] += (prod[:, j * nz:(j + 1) * nz]
+                              + 1j * prod[:, half + j * nz:half + (j + 1) * nz]).T
     return out
 
 
