@@ -46,6 +46,7 @@ from scipy.stats import gamma, norm
 from tqdm.auto import tqdm
 
 from .._validate import AliasingWarning
+from ..analysis.noise import smooth_residual_energy
 from ..data.hologram import C0, Hologram
 from ..physics.medium import Medium
 from .migrate import migrate
@@ -613,29 +614,7 @@ class _Search:
         phi = float(np.sum(D * Rk) / (per * s2 * np.sum(D))) if np.sum(D) > 0 else 1.0
         return dict(s2=s2, detection=float(detection), threshold=threshold,
                     phi=max(1.0, phi), residual_scale=2.0 if pr.phase_only else 1.0,
-                    model_error=_correlated_energy(r.reshape(self.hologram.data.shape)))
-
-
-def _correlated_energy(r: np.ndarray) -> float:
-    """Energy of the part of a residual that is smooth from element to element.
-
-    Receiver noise is white: neighbouring elements' residuals are uncorrelated. A
-    model error (an object that is not a point, a vector field, an inexact ground)
-    varies smoothly across the aperture, so the lag-one autocovariance ``C1`` of
-    the residual measures its power: the energy ``sum |r|^2 * |C1|/C0``, counted
-    only when ``|C1|/C0`` exceeds three times its spread for white noise
-    (``1/sqrt(pairs)``).
-    """
-    c0 = float(np.mean(np.abs(r) ** 2))
-    if c0 == 0:
-        return 0.0
-    pairs = [(r[..., :, 1:], r[..., :, :-1]), (r[..., 1:, :], r[..., :-1, :])]
-    n = sum(a.size for a, _ in pairs)
-    c1 = sum(np.vdot(b, a) for a, b in pairs) / n
-    rho = min(1.0, abs(c1) / c0)
-    if rho < 3 / np.sqrt(n):
-        return 0.0
-    return float(rho * np.sum(np.abs(r) ** 2))
+                    model_error=smooth_residual_energy(r.reshape(self.hologram.data.shape)))
 
 
 def _no_object(stats: dict[str, float]) -> str:

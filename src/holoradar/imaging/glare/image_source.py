@@ -57,6 +57,31 @@ def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
     return float(np.sqrt(max(cov[0, 0], 0))), float(np.sqrt(max(cov[1, 1], 0)))
 
 
+def _model_error_bound(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
+                       ) -> tuple[float, float]:
+    """Largest shift of each parameter that the residual's smooth part could cause.
+
+    Receiver noise is white over the aperture; what the model misses (a vector field
+    seen as a scalar one, a layered ground seen as a half-space, a solver's own
+    dispersion) is smooth from element to element. Its energy ``E_err``
+    (:func:`~holoradar.analysis.noise.smooth_residual_energy`), were it aligned with
+    the worst direction, moves parameter j by ``sqrt(E_err [(J^T J)^-1]_jj)``
+    (least squares, J the residual's Jacobian). Zero when the residual is white.
+    """
+    from ...analysis.noise import smooth_residual_energy
+
+    n = fun.size // 2
+    e_err = smooth_residual_energy((fun[:n] + 1j * fun[n:]).reshape(shape))
+    if e_err == 0:
+        return 0.0, 0.0
+    try:
+        inv = np.linalg.inv(jac.T @ jac)
+    except np.linalg.LinAlgError:
+        return np.inf, np.inf
+    d = np.sqrt(np.clip(np.diag(inv), 0, None) * e_err)
+    return float(d[0]), float(d[1])
+
+
 def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarray,
                       h: np.ndarray, D: np.ndarray | None, ref: complex | None,
                       initial: dict[str, Any] | None,
@@ -106,10 +131,15 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
     sol = least_squares(resid, e_start, x_scale=np.array([0.1, 0.01]) * max(e_start[0], 1.0),
                         bounds=([1e-3, 0.0], [np.inf, np.inf]), xtol=1e-12, max_nfev=200)
     a, G, _ = parts(sol.x)
-    std = _sandwich_std(sol.fun, sol.jac, th.shape)
+    noise_std = _sandwich_std(sol.fun, sol.jac, th.shape)
+    bias = _model_error_bound(sol.fun, sol.jac, th.shape)
+    # The stated 1-sigma covers noise (sandwich) and, through bias/1.96, the largest shift
+    # the residual's smooth part (model error) could cause: +-1.96 sigma holds both.
+    std = (noise_std[0] + bias[0] / 1.96, noise_std[1] + bias[1] / 1.96)
     eps = complex(sol.x[0], sol.x[1])
     explained = 1 - np.sum(sol.fun**2) / max(np.sum(np.abs(h) ** 2), 1e-300)
-    fit = {"eps": eps, "eps_std": std, "a": a,
+    fit = {"eps": eps, "eps_std": std, "eps_noise_std": noise_std, "eps_model_bias": bias,
+           "a": a,
            "converged": bool(sol.success and explained > 0.5)}
     dcoef = None if D is None else a
     return a * G, (np.zeros_like(h) if D is None else a * D), dcoef, fit
