@@ -432,6 +432,7 @@ class _Search:
             _, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
         self.z0 = z0
         self.xy = np.array([img.x[ix], img.y[iy]], float)
+        self.pr.xy_hint = self.xy
         # The object's range from the point fit itself along that column: an image's
         # brightest plane may sit far off (a wide depth of focus, aliasing, brighter
         # shallow planes); a point's response matches only near its own range.

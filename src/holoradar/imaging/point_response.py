@@ -99,6 +99,7 @@ class PointResponse:
     """
 
     LATERAL_MARGIN = 0.05
+    SOURCE_BAND = 0.12  # half-width (m) of the source's table around ``xy_hint``
 
     def __init__(self, hologram: Hologram, make_medium: Callable[[float], Medium], *,
                  coherent: bool, phase_only: bool = False) -> None:
@@ -131,6 +132,7 @@ class PointResponse:
             far = np.hypot(*np.maximum(abs(self.bounds[0] - s[:2]), abs(self.bounds[1] - s[:2])))
             self._rho_max_src = float(far) + self.LATERAL_MARGIN
         self._windows: dict[float, list[_Window]] = {}
+        self.xy_hint: Any = None  # where the object is (x, y): the source's table covers it
 
     # ------------------------------------------------------------ responses
     def spacing(self, eps: float) -> float:
@@ -199,7 +201,13 @@ class PointResponse:
         E = None
         if self._point_source and self.vector:
             s = self.source.position
-            sgrid = np.arange(0.0, self._rho_max_src + 3 * rstep, rstep)
+            lo, hi = 0.0, self._rho_max_src
+            if self.xy_hint is not None:
+                # Only a band of distances from the source around the located object: the
+                # fits stay within a few wavelengths of it (outside, the exact field).
+                r = float(np.hypot(*(np.asarray(self.xy_hint) - s[:2])))
+                lo, hi = max(0.0, r - self.SOURCE_BAND), min(hi, r + self.SOURCE_BAND)
+            sgrid = np.arange(max(0.0, lo - 2 * rstep), hi + 3 * rstep, rstep)
             E = _VGrid(zs, sgrid, np.stack([dyadic_profiles(float(k), medium, float(s[2]), zs,
                                                             sgrid) for k in self.ks]))
         elif self._point_source:
@@ -274,7 +282,8 @@ class PointResponse:
                          w: _Window | None) -> np.ndarray:
         """The incident field vector at the object, (nf, 3)."""
         s = self.source
-        if w is not None and self._point_source:
+        if w is not None and self._point_source and w.E.holds_rho(
+                float(np.hypot(xy[0] - s.position[0], xy[1] - s.position[1]))):
             off = np.array([[xy[0] - s.position[0], xy[1] - s.position[1]]])
             moment = (s.moment if isinstance(s, Dipole) else np.asarray(s.polarization))
             prof = w.E(z, np.hypot(off[:, 0], off[:, 1]))
@@ -397,6 +406,10 @@ class _VGrid:
         self.z0, self.dz = float(zs[0]), float(zs[1] - zs[0])
         self.r0, self.dr = float(rho[0]), float(rho[1] - rho[0])
         self.nz, self.nr = zs.size, rho.size
+
+    def holds_rho(self, rho: float) -> bool:
+        """True when ``rho`` lies inside the table (its stencil never reaches beyond)."""
+        return self.r0 <= rho <= self.r0 + (self.nr - 2) * self.dr
 
     def __call__(self, z: float, rho: np.ndarray) -> np.ndarray:
         """Radial functions at range ``z`` and distances ``rho``: (nf, 5, len(rho))."""

@@ -29,10 +29,12 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     has one (a :class:`~holoradar.Dipole`, a polarised horn or beam), the glare
     and the direct wave are the vector fields, TE and TM waves each reflected
     with their own law; otherwise the scalar (TE) model. The 1-sigma covers
-    receiver noise and diffuse clutter (a sandwich estimate); it does not cover
-    model error (a vector source seen as a scalar one) nor the bias of a single
-    strong buried object, at most
-    ``4 n |V| e / (1 + V)^2`` for an object ``e`` times weaker than the glare.
+    receiver noise and diffuse clutter (a sandwich estimate) plus, through
+    ``b/1.96``, the largest shift ``b`` that the residual's smooth part (model
+    error: a scalar model of a vector source, a layered ground seen as a
+    half-space, a buried object under the glare) could cause; a white residual
+    adds nothing. The noise-only sigma and ``b`` are in the
+    ``suppress_surface(..., "image_source")`` report's ``parameters``.
 
     Examples
     --------
