@@ -132,6 +132,8 @@ class AutofocusResult:
     integrals: int = 0
     seconds: float = 0.0
     medium: Medium | None = field(default=None, repr=False)
+    line_azimuth_deg: float | None = None
+    line_length: float | None = None
 
     @property
     def std(self) -> float | None:
@@ -164,6 +166,7 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
               position: tuple[float, float] | None = None,
               glare: bool | tuple[float, float] | None = None,
               fit: Literal["field", "phase"] = "field", confidence: float = 0.95,
+              target: Literal["point", "line"] = "point", line_radius: float = 0.006,
               progress: bool = False) -> AutofocusResult:
     """Find the ground permittivity eps' (and the object's range) that focuses best.
 
@@ -203,6 +206,19 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         estimate made elsewhere. Default: no glare estimate.
     confidence : float
         Confidence of the interval, default 0.95.
+    target : {"point", "line"}
+        The object: ``"point"`` (default), a compact scatterer (an isotropic induced
+        dipole in the vector model); ``"line"``, a horizontal cylinder (rebar, pipe)
+        whose centre, range, azimuth and length are fitted with eps'
+        (``result.line_azimuth_deg``, ``result.line_length``), modelled as the
+        simulation's :class:`~holoradar.LineTarget`. Lines need the vector model
+        (a hologram with a ``polarization`` and a polarised source) on an untilted
+        grid, and are slow (every trial line costs nodes x elements x frequencies
+        interpolations).
+    line_radius : float
+        The cylinder's radius in metres for ``target="line"`` (default 0.006, a 12 mm
+        bar; a perfect conductor). A thick bar echoes from its near side: a wrong
+        radius biases eps' by about ``(a_true - a)/depth``.
     progress : bool
         Show a progress bar over the trial permittivities.
 
@@ -259,7 +275,20 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
               "several frequencies without the illumination: the wave front's shape only")
     if fit not in ("phase", "field"):
         raise ValueError(f"fit must be 'phase' or 'field', got {fit!r}")
-    pr = PointResponse(hologram, make, coherent=coherent, phase_only=fit == "phase")
+    if target not in ("point", "line"):
+        raise ValueError(f"target must be 'point' (a compact object) or 'line' (rebar, pipe), "
+                         f"got {target!r}")
+    if target == "line":
+        from .line_response import LineResponse
+
+        r = float(line_radius) if np.isscalar(line_radius) else np.nan
+        if not (np.isfinite(r) and r > 0):
+            raise ValueError(f"line_radius must be the bar's radius in metres (> 0), got "
+                             f"{line_radius!r}")
+        pr = LineResponse(hologram, make, coherent=coherent, phase_only=fit == "phase",
+                          radius=r)
+    else:
+        pr = PointResponse(hologram, make, coherent=coherent, phase_only=fit == "phase")
     search = _Search(pr, make, lo, hi, hologram)
     z0 = make(lo).z_interfaces[0]
     base = dict(confidence=confidence, handle=handle, eps_glare=None if glare_est is None
@@ -300,6 +329,14 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     order = sorted(grid, key=lambda e: abs(np.log(e / mid)))
     for e in tqdm(order, desc="autofocus", unit="eps", disable=not progress, delay=1.0):
         search.evaluate(float(e))
+    if target == "line":
+        # The line's azimuth and length again at the sweep's best eps', then the sweep
+        # once more with that shape held: every eps' compared with one shape.
+        e_best = max(search.best, key=lambda e: search.best[e][0])
+        search.evaluate(e_best, refine_shape=True)
+        search.best = {e_best: search.best[e_best]}
+        for e in order:
+            search.evaluate(float(e))
     # Local maxima of the sweep, and (several frequencies) every eps' where curvature and
     # an alias of the delay agree: each refined, the best kept, the others checked below.
     F_grid = [search.best[float(e)][0] for e in grid]
@@ -326,7 +363,9 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     # 4. Noise level, detection and the sandwich factor at the optimum.
     stats = search.statistics(e_hat, z_hat, xy_hat)
     pos = (float(xy_hat[0]), float(xy_hat[1]), float(z_hat))
-    common = dict(position=pos, depth=float(z_hat - z0), focus_fraction=F_max,
+    line = {} if len(xy_hat) < 4 else dict(
+        line_azimuth_deg=float(np.degrees(xy_hat[2]) % 180.0), line_length=float(xy_hat[3]))
+    common = dict(position=pos, depth=float(z_hat - z0), focus_fraction=F_max, **line,
                   detection=stats["detection"], detection_threshold=stats["threshold"],
                   noise_inflation=stats["phi"])
     if stats["detection"] < stats["threshold"]:
@@ -432,7 +471,9 @@ class _Search:
             _, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
         self.z0 = z0
         self.xy = np.array([img.x[ix], img.y[iy]], float)
-        self.pr.xy_hint = self.xy
+        if getattr(self.pr, "max_length", None) is not None:
+            self.xy = _line_from_image(a, img.x, img.y, iy, ix, self.pr.max_length, lam_m)
+        self.pr.xy_hint = self.xy[:2]
         # The object's range from the point fit itself along that column: an image's
         # brightest plane may sit far off (a wide depth of focus, aliasing, brighter
         # shallow planes); a point's response matches only near its own range.
@@ -489,13 +530,14 @@ class _Search:
         top = self.z0 + (self.A - self.z0) * np.sqrt(max(abs(e) for e in m.eps)) * 2 + 1e-3
         return float(brentq(lambda z: m.apparent_distance(z) - self.A, self.z0, top))
 
-    def evaluate(self, eps: float) -> tuple[float, float, np.ndarray]:
+    def evaluate(self, eps: float, refine_shape: bool = False) -> tuple[float, float, np.ndarray]:
         """Best focus fraction at ``eps`` with its range and lateral position.
 
         Bounded Gauss-Newton (trust region) on the residual ``h - a g`` with the
-        amplitude ``a`` projected out, from the best range of a scan.
+        amplitude ``a`` projected out, from the best range of a scan. A line's
+        azimuth and length are fitted at the first trial and with ``refine_shape``.
         """
-        if eps in self.best:
+        if eps in self.best and not refine_shape:
             return self.best[eps]
         pr = self.pr
         floor = self.z0 + pr.spacing(eps) / 4
@@ -521,10 +563,18 @@ class _Search:
         else:
             z_start, _ = pr.scan(eps, max(z_c - lam_m / 2, floor),
                                  max(z_c + lam_m / 2, floor + lam_m), xy0)
-        p0 = np.array([xy0[0], xy0[1], z_start])
+        shape0 = np.asarray(xy0[2:], float)          # a line's azimuth and length
+        if shape0.size and self.best and not refine_shape:
+            # A line's shape hardly depends on eps': fitted once (the first trial, and
+            # at the optimum), held during the sweep.
+            return self._evaluate_fixed_shape(eps, floor, xy0, z_start, lam_m)
+        p0 = np.array([xy0[0], xy0[1], z_start, *shape0])
+
+        def params(p: np.ndarray) -> np.ndarray:
+            return np.r_[p[:2], p[3:]]
 
         def resid(p: np.ndarray) -> np.ndarray:
-            r, _, _ = pr.residual(eps, max(p[2], floor), p[:2])
+            r, _, _ = pr.residual(eps, max(p[2], floor), params(p))
             return np.concatenate([r.real.ravel(), r.imag.ravel()])
 
         # Bounded to the scanned peak's basin: an unbounded first step may jump to another
@@ -536,13 +586,44 @@ class _Search:
         hi_b = np.array([*np.minimum(p0[:2] + 2 * lam_m, pr.bounds[1]), p0[2] + reach])
         lo_b[:2] = np.minimum(lo_b[:2], p0[:2] - 1e-9)  # a non-empty box at the edge
         hi_b[:2] = np.maximum(hi_b[:2], p0[:2] + 1e-9)
+        scale = np.full(3, self.lam / 10)
+        if shape0.size:  # azimuth within 20 degrees, length within a factor 2 of the start
+            L0 = float(shape0[1])
+            lo_b = np.r_[lo_b, shape0[0] - 0.35, max(lam_m, 0.5 * L0)]
+            hi_b = np.r_[hi_b, shape0[0] + 0.35, max(min(pr.max_length, 2 * L0), lam_m * 1.01)]
+            p0[3:] = np.clip(p0[3:], lo_b[3:] + 1e-9, hi_b[3:] - 1e-9)
+            scale = np.r_[scale, 0.02, self.lam / 10]
         sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-12,
-                            ftol=1e-15, gtol=1e-15, x_scale=np.full(3, self.lam / 10))
+                            ftol=1e-15, gtol=1e-15, x_scale=scale)
         p = sol.x
         z = max(float(p[2]), floor)
-        xy = np.clip(p[:2], *pr.bounds)
+        xy = np.r_[np.clip(p[:2], *pr.bounds), p[3:]]
         F = pr.focus(eps, z, xy)
         self.best[eps] = (F, z, xy)
+        return self.best[eps]
+
+    def _evaluate_fixed_shape(self, eps: float, floor: float, xy0: np.ndarray, z_start: float,
+                              lam_m: float) -> tuple[float, float, np.ndarray]:
+        pr = self.pr
+        shape = np.asarray(xy0[2:], float)
+        p0 = np.array([xy0[0], xy0[1], z_start])
+
+        def resid(p: np.ndarray) -> np.ndarray:
+            r, _, _ = pr.residual(eps, max(p[2], floor), np.r_[p[:2], shape])
+            return np.concatenate([r.real.ravel(), r.imag.ravel()])
+
+        reach = C0 / (4 * self.band * np.sqrt(eps)) if self.wideband else 2 * lam_m
+        p0[:2] = np.clip(p0[:2], *pr.bounds)
+        lo_b = np.array([*np.maximum(p0[:2] - 2 * lam_m, pr.bounds[0]),
+                         max(p0[2] - reach, floor)])
+        hi_b = np.array([*np.minimum(p0[:2] + 2 * lam_m, pr.bounds[1]), p0[2] + reach])
+        lo_b[:2] = np.minimum(lo_b[:2], p0[:2] - 1e-9)
+        hi_b[:2] = np.maximum(hi_b[:2], p0[:2] + 1e-9)
+        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-10,
+                            ftol=1e-12, gtol=1e-12, x_scale=np.full(3, self.lam / 10))
+        z = max(float(sol.x[2]), floor)
+        xy = np.r_[np.clip(sol.x[:2], *pr.bounds), shape]
+        self.best[eps] = (pr.focus(eps, z, xy), z, xy)
         return self.best[eps]
 
     def crossing(self, e_hat: float, level: float, side: int) -> float | None:
@@ -600,8 +681,11 @@ class _Search:
         for sel in groups:  # each amplitude: its phase, and for a field fit its modulus
             t = np.where(sel[:, None], m0, 0)
             tangents += [1j * t] if pr.phase_only else [t, 1j * t]
-        for dv in (np.array([dx, 0]), np.array([0, dx])):
-            tangents.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * dx))
+        steps = [dx, dx, 1e-3, dx][:len(xy)]  # x, y (and a line's azimuth, length)
+        for i, step in enumerate(steps):
+            dv = np.zeros(len(xy))
+            dv[i] = step
+            tangents.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * step))
         tangents.append((model(eps, z + dz, xy) - model(eps, z - dz, xy)) / (2 * dz))
         T = np.stack([np.concatenate([t.real.ravel(), t.imag.ravel()]) for t in tangents], 1)
         d = np.concatenate([d_eps.real.ravel(), d_eps.imag.ravel()])
@@ -616,6 +700,31 @@ class _Search:
         return dict(s2=s2, detection=float(detection), threshold=threshold,
                     phi=max(1.0, phi), residual_scale=2.0 if pr.phase_only else 1.0,
                     model_error=smooth_residual_energy(r.reshape(self.hologram.data.shape)))
+
+
+def _line_from_image(a: np.ndarray, x: np.ndarray, y: np.ndarray, iy: int, ix: int,
+                     max_length: float, lam_m: float) -> np.ndarray:
+    """A line's start (x, y, azimuth, length) from a migrated image's plane that holds the
+    brightest pixel: the pixels above half of it that connect to it, their
+    intensity-weighted centre and principal axis, and their extent along it."""
+    from scipy import ndimage
+
+    plane = a.reshape((-1, *a.shape[-3:])).max(axis=0)
+    iz = int(np.argmax(plane[:, iy, ix]))
+    p = plane[iz]
+    labels, _ = ndimage.label(p >= 0.5 * p[iy, ix])
+    sel = labels == labels[iy, ix]
+    X, Y = np.meshgrid(x, y)
+    w = p[sel] ** 2
+    cx, cy = float(np.average(X[sel], weights=w)), float(np.average(Y[sel], weights=w))
+    dx, dy = X[sel] - cx, Y[sel] - cy
+    cov = np.cov(np.stack([dx, dy]), aweights=w) if sel.sum() > 2 else np.eye(2)
+    _, vecs = np.linalg.eigh(cov)
+    t = vecs[:, -1]
+    along = dx * t[0] + dy * t[1]
+    length = float(np.clip(np.ptp(along) + 2 * float(abs(x[1] - x[0])), 2 * lam_m,
+                           max_length))
+    return np.array([cx, cy, float(np.arctan2(t[1], t[0])), length])
 
 
 def _no_object(stats: dict[str, float]) -> str:

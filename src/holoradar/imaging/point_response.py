@@ -413,14 +413,29 @@ class _VGrid:
 
     def __call__(self, z: float, rho: np.ndarray) -> np.ndarray:
         """Radial functions at range ``z`` and distances ``rho``: (nf, 5, len(rho))."""
+        v = (np.asarray(rho, float) - self.r0) / self.dr
+        ir = np.clip(np.floor(v).astype(int), 1, self.nr - 3)
+        lo, hi = int(ir.min()) - 1, int(ir.max()) + 3   # only the columns in use
+        return self.along(self.row(z, lo, hi), rho, lo)
+
+    def row(self, z: float, lo: int = 0, hi: int | None = None) -> np.ndarray:
+        """The table interpolated to range ``z`` (columns ``lo:hi``): (nf, 6, n)."""
         u = (z - self.z0) / self.dz
         iz = min(max(int(np.floor(u)), 1), self.nz - 3)
         wz = _Grid._weights(np.array(u - iz))
+        return np.tensordot(wz, self.table[:, iz - 1:iz + 3, :, lo:hi], axes=(0, 1))
+
+    def along(self, row: np.ndarray, rho: np.ndarray, lo: int = 0) -> np.ndarray:
+        """Radial functions at distances ``rho`` from a :meth:`row` that starts at column
+        ``lo``: (nf, 5, len(rho)); four weighted gathers (the 4-point stencil)."""
         v = (np.asarray(rho, float) - self.r0) / self.dr
         ir = np.clip(np.floor(v).astype(int), 1, self.nr - 3)
         wr = _Grid._weights(v - ir)                                   # (N, 4)
-        idx = ir[:, None] + np.arange(-1, 3)                          # (N, 4)
-        lo, hi = int(idx.min()), int(idx.max()) + 1       # only the columns in use
-        rows = np.tensordot(wz, self.table[:, iz - 1:iz + 3, :, lo:hi], axes=(0, 1))
-        vals = np.einsum("fcnk,nk->fcn", rows[:, :, idx - lo], wr)      # (nf, 6, N)
+        base = ir - 1 - lo
+        # Gather whole columns (all frequencies and functions, contiguous) per stencil point.
+        cols = np.ascontiguousarray(row.reshape(-1, row.shape[-1]).T)   # (n, nf * 6)
+        vals = cols[base] * wr[:, :1]
+        for j in (1, 2, 3):
+            vals += cols[base + j] * wr[:, j:j + 1]
+        vals = vals.T.reshape(row.shape[0], row.shape[1], -1)
         return vals[:, :5] * np.exp(1j * vals[:, 5].real)[:, None, :]
