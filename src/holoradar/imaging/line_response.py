@@ -27,12 +27,9 @@ import numpy as np
 
 from ..data.hologram import Hologram
 from ..model.targets import cylinder_polarizabilities
-from ..physics.dipole import Dipole
-from ..physics.dyadic import dyadic_from_profiles, dyadic_times
+from ..physics.dyadic import dyadic_times
 from ..physics.green import _legendre
 from ..physics.medium import Medium
-from ..physics.sources import PlaneWave, PointSource, ray_direction
-from ..physics.vector_waves import vector_transfer
 from .point_response import PointResponse
 
 __all__ = ["LineResponse"]
@@ -91,33 +88,6 @@ class LineResponse(PointResponse):
         pos = np.array([x, y]) + 0.5 * length * s[:, None] * t
         return pos, 0.5 * length * np.asarray(w), np.array([t[0], t[1], 0.0])
 
-    def _incident(self, eps: float, z: float, pos: np.ndarray, medium: Medium,
-                  window: Any) -> np.ndarray:
-        """Incident field vectors at the nodes, (nf, M, 3)."""
-        s = self.source
-        if isinstance(s, PlaneWave):
-            p0, q0 = s.wavenumbers(1.0)
-            out = []
-            for k in self.ks:
-                v = vector_transfer(float(k), medium, np.array(p0 * k), np.array(q0 * k),
-                                    np.array(s.polarization), 0.0, z)
-                lateral = np.exp(1j * k * (p0 * pos[:, 0] + q0 * pos[:, 1]))
-                out.append(v[None, :] * lateral[:, None])
-            return np.array(out)
-        off = pos - s.position[:2]
-        rho = np.hypot(off[:, 0], off[:, 1])
-        if window is not None and self._point_source and all(window.E.holds_rho(float(r))
-                                                             for r in (rho.min(), rho.max())):
-            moment = (s.moment if isinstance(s, Dipole) else np.asarray(s.polarization))
-            E = s.amplitude * (dyadic_from_profiles(off, window.E(z, rho)) @ moment)
-            if isinstance(s, PointSource) and s.pattern_exponent:
-                pts = np.c_[pos, np.full(len(pos), z)]
-                E = E * np.stack([s.pattern(ray_direction(float(k), medium, s.position, pts))
-                                  for k in self.ks])[:, :, None]
-            return E
-        pts = np.c_[pos, np.full(len(pos), z)]
-        return np.stack([s.field_vector(float(k), medium, pts) for k in self.ks])
-
     # --------------------------------------------------------------- response
     def response(self, eps: float, z: float, xy: Any, *, window: Any = None) -> np.ndarray:
         """``g`` at the elements, (nf, N), for the line ``xy = (x, y, azimuth, length)``."""
@@ -126,7 +96,7 @@ class LineResponse(PointResponse):
         w = window or self._window(eps, z)
         medium = w.medium
         pos, weights, t = self._nodes(xy)
-        E = self._incident(eps, z, pos, medium, w)                      # (nf, M, 3)
+        E = self._incident_vectors(medium, pos, z, w)                   # (nf, M, 3)
         km = self.ks * np.sqrt(complex(medium.eps[medium.region_of(z)]))
         tt = np.outer(t, t)
         eps_ground = complex(medium.eps[medium.region_of(z)])

@@ -281,26 +281,35 @@ class PointResponse:
     def _incident_vector(self, medium: Medium, pos: np.ndarray, xy: Any, z: float,
                          w: _Window | None) -> np.ndarray:
         """The incident field vector at the object, (nf, 3)."""
+        return self._incident_vectors(medium, np.atleast_2d(np.asarray(xy, float)[:2]), z,
+                                      w)[:, 0]
+
+    def _incident_vectors(self, medium: Medium, xy: np.ndarray, z: float,
+                          w: _Window | None) -> np.ndarray:
+        """The incident field vectors at lateral positions ``xy`` (M, 2) on range ``z``,
+        (nf, M, 3): the source's table where it covers them, closed form for a plane
+        wave, else the source's exact field."""
         s = self.source
-        if w is not None and self._point_source and w.E.holds_rho(
-                float(np.hypot(xy[0] - s.position[0], xy[1] - s.position[1]))):
-            off = np.array([[xy[0] - s.position[0], xy[1] - s.position[1]]])
-            moment = (s.moment if isinstance(s, Dipole) else np.asarray(s.polarization))
-            prof = w.E(z, np.hypot(off[:, 0], off[:, 1]))
-            E = s.amplitude * (dyadic_from_profiles(off, prof)[:, 0] @ moment)
-            if isinstance(s, PointSource) and s.pattern_exponent:
-                E = E * np.array([s.pattern(ray_direction(float(k), medium, s.position,
-                                                          pos))[0] for k in self.ks])[:, None]
-            return E
+        pts = np.c_[xy, np.full(len(xy), z)]
         if isinstance(s, PlaneWave):
             p0, q0 = s.wavenumbers(1.0)
             out = []
             for k in self.ks:
                 v = vector_transfer(float(k), medium, np.array(p0 * k), np.array(q0 * k),
                                     np.array(s.polarization), 0.0, z)
-                out.append(v * np.exp(1j * k * (p0 * xy[0] + q0 * xy[1])))
+                out.append(v[None, :] * np.exp(1j * k * (xy @ np.array([p0, q0])))[:, None])
             return np.array(out)
-        return np.stack([s.field_vector(float(k), medium, pos)[0] for k in self.ks])
+        if w is not None and self._point_source:
+            off = xy - s.position[:2]
+            rho = np.hypot(off[:, 0], off[:, 1])
+            if w.E.holds_rho(float(rho.min())) and w.E.holds_rho(float(rho.max())):
+                moment = (s.moment if isinstance(s, Dipole) else np.asarray(s.polarization))
+                E = s.amplitude * (dyadic_from_profiles(off, w.E(z, rho)) @ moment)
+                if isinstance(s, PointSource) and s.pattern_exponent:
+                    E = E * np.stack([s.pattern(ray_direction(float(k), medium, s.position,
+                                                              pts)) for k in self.ks])[..., None]
+                return E
+        return np.stack([s.field_vector(float(k), medium, pts) for k in self.ks])
 
     # ------------------------------------------------------------- matching
     def match(self, g: np.ndarray, *, phase: bool | None = None,
