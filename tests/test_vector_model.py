@@ -9,14 +9,13 @@ polar vector) keeps E_x, E_y and changes the sign of E_z.
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 import holoradar as hr
 from conftest import DATA
 from holoradar.physics.medium import fresnel
+from test_fixtures_layers import _load  # the S6 fixture's reader
 
 F = 9.9e9
 K = 2 * np.pi * F / hr.C0
@@ -127,16 +126,8 @@ def test_polarization_is_normalised_and_kept():
 
 
 # --------------------------------------------------------- scattering, S6 fixture
-def _s6():
-    meta = json.loads((DATA / "S6_void_under_layers.json").read_text())
-    with np.load(DATA / "S6_void_under_layers.npz") as d:
-        data = {c: d[f"E_scat_{c}"].copy() for c in ("H", "A")}
-        s = d["s_m"].copy()
-    return meta, s, data
-
-
 def _void_residual(case: str) -> float:
-    meta, s, data = _s6()
+    meta, s, data = _load()
     c = meta["cases"][case]
     z = Z0 + np.concatenate([[0.0], np.cumsum(c["layer_thickness_m"])])
     m = hr.Medium.layered(z, [complex(*e) for e in c["eps_top_down"]])

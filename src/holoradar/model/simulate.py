@@ -41,7 +41,12 @@ from tqdm.auto import tqdm
 
 from .._validate import as_polarization, as_real, check_frequency
 from ..data.hologram import C0, Hologram, _frequency_axis, has_polarization
-from ..physics.dyadic import RadialDyadic, reflected_dyadic, transmitted_dyadic
+from ..physics.dyadic import (
+    RadialDyadic,
+    free_space_dyadic,
+    reflected_dyadic,
+    transmitted_dyadic,
+)
 from ..physics.green import free_space_green, green_at_distances
 from ..physics.medium import Medium
 from ..physics.propagation import lateral_travel
@@ -233,7 +238,6 @@ def _receiving(k: float, medium: Medium, z_e: float, z_t: float, offsets: np.nda
         if z_t >= z_e:
             G = transmitted_dyadic(k, medium, src, pts)
         else:
-            from ..physics.dyadic import free_space_dyadic
             G = free_space_dyadic(k, src, pts)
         if not medium.is_free_space:
             G = G + reflected_dyadic(k, medium, src, pts)

@@ -10,10 +10,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import as_complex_scalar, as_polarization, as_position, as_real
+from .._validate import as_complex_scalar, as_position, as_real
 from ._geometry import _points
 from .medium import Medium
-from .vector_waves import transverse, vector_transfer
+from .vector_waves import vector_transfer, wave_polarization
 
 __all__ = ["GaussianBeam"]
 
@@ -73,10 +73,8 @@ class GaussianBeam:
             raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
                              f"propagating beam), got alpha={self.alpha}, beta={self.beta}")
         object.__setattr__(self, "amplitude", as_complex_scalar(self.amplitude, "amplitude"))
-        pol = as_polarization(self.polarization, "polarization")
-        if pol is not None:
-            pol = transverse(self.direction, pol)
-            object.__setattr__(self, "polarization", tuple(float(v) for v in pol))
+        object.__setattr__(self, "polarization",
+                           wave_polarization(self.direction, self.polarization))
 
     def _vector(self, k: float, medium: Medium, points: np.ndarray, reflected: bool
                 ) -> np.ndarray:

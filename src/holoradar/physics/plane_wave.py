@@ -10,10 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import as_polarization, as_real
+from .._validate import as_real
 from ._geometry import _points
 from .medium import Medium
-from .vector_waves import transverse, vector_transfer
+from .vector_waves import vector_transfer, wave_polarization
 
 __all__ = ["PlaneWave"]
 
@@ -57,10 +57,8 @@ class PlaneWave:
         if np.sin(self.alpha) ** 2 + np.sin(self.beta) ** 2 >= 1:
             raise ValueError("alpha, beta must satisfy sin(alpha)^2 + sin(beta)^2 < 1 (a "
                              f"propagating wave), got alpha={self.alpha}, beta={self.beta}")
-        pol = as_polarization(self.polarization, "polarization")
-        if pol is not None:
-            pol = transverse(self.direction, pol)
-            object.__setattr__(self, "polarization", tuple(float(v) for v in pol))
+        object.__setattr__(self, "polarization",
+                           wave_polarization(self.direction, self.polarization))
 
     @property
     def direction(self) -> np.ndarray:

@@ -25,7 +25,7 @@ import numpy as np
 
 from .medium import Medium
 
-__all__ = ["transverse", "vector_transfer"]
+__all__ = ["transverse", "vector_transfer", "wave_polarization"]
 
 
 def transverse(direction: np.ndarray, polarization: np.ndarray, name: str = "polarization"
@@ -51,6 +51,24 @@ def transverse(direction: np.ndarray, polarization: np.ndarray, name: str = "pol
                          f"{np.round(d, 6).tolist()}: a plane wave has no field along it; give "
                          "a direction across it, e.g. (0, 1, 0)")
     return e / n
+
+
+def wave_polarization(direction: np.ndarray, value: object
+                      ) -> tuple[float, float, float] | None:
+    """A wave's ``polarization`` argument checked (a real non-zero 3-vector, normalised)
+    and made transverse to its unit ``direction``; None stays None.
+
+    Examples
+    --------
+    >>> wave_polarization(np.array([0.0, 0.0, 1.0]), (0, 2, 1))
+    (0.0, 1.0, 0.0)
+    """
+    from .._validate import as_polarization
+
+    pol = as_polarization(value, "polarization")
+    if pol is None:
+        return None
+    return tuple(float(v) for v in transverse(direction, pol))
 
 
 def _basis(k: float, p: np.ndarray, q: np.ndarray, kz0: np.ndarray):
