@@ -57,6 +57,11 @@ __all__ = ["AutofocusResult", "autofocus"]
 _COARSE = 10          # eps' values of the first sweep (geometric)
 _FALSE_ALARM = 1e-3   # detection: chance that noise alone passes
 _MODEL_PRECISION = 1e-4  # relative amplitude accuracy of the model (quadrature, splines)
+# The position fit's stopping rule. Gauss-Newton converges quadratically, so a step that
+# lowers the residual by less than _FTOL of itself leaves an error far below that; the
+# interval's drop is >= 1e-4 of the residual (noise), so 1e-8 is ample. _XTOL: metres.
+_FTOL = 1e-8
+_XTOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -220,7 +225,8 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         bar; a perfect conductor). A thick bar echoes from its near side: a wrong
         radius biases eps' by about ``(a_true - a)/depth``.
     progress : bool
-        Show a progress bar over the trial permittivities.
+        Show a progress bar over all the work: locating the object, then every trial
+        permittivity (its total grows when the refinement needs more).
 
     Returns
     -------
@@ -289,7 +295,12 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
                           radius=r)
     else:
         pr = PointResponse(hologram, make, coherent=coherent, phase_only=fit == "phase")
-    search = _Search(pr, make, lo, hi, hologram)
+    # Locating, the middle trial, the sweep, about 8 refinements and 6 for the interval
+    # (a line: the sweep twice).
+    expected = 2 + _COARSE * (2 if target == "line" else 1) + 14
+    bar = tqdm(total=expected, desc="autofocus", unit="trial", disable=not progress,
+               delay=1.0)
+    search = _Search(pr, make, lo, hi, hologram, bar)
     z0 = make(lo).z_interfaces[0]
     base = dict(confidence=confidence, handle=handle, eps_glare=None if glare_est is None
                 else glare_est[0], eps_glare_std=None if glare_est is None else glare_est[1])
@@ -304,6 +315,9 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
             kw.update(eps=g, eps_interval=(g - q * s, g + q * s), determinable=True,
                       reason=f"from the glare alone (the focus gave no handle: {kw['reason']})",
                       medium=make(g))
+        bar.total = bar.n
+        bar.refresh()
+        bar.close()
         return AutofocusResult(eps_grid=grid, profile=prof, evaluations=pr.responses,
                                integrals=pr.integrals,
                                seconds=time.perf_counter() - t_start, **kw)
@@ -311,6 +325,7 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     # 1. Where is the object? Laterally the brightest column of a migrated image; its
     #    range, curvature and delay from the point fit along that column.
     located = search.locate(depth_range, position, z0)
+    bar.update()
     if located is None:
         return finish(eps=None, eps_interval=None, determinable=False,
                       reason="the brightest focus lies at the ground surface or above it, not "
@@ -327,7 +342,7 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
                       detection=pre["detection"], detection_threshold=pre["threshold"])
     # 3. Coarse sweep of eps' outwards from there, each with its best range and position.
     order = sorted(grid, key=lambda e: abs(np.log(e / mid)))
-    for e in tqdm(order, desc="autofocus", unit="eps", disable=not progress, delay=1.0):
+    for e in order:
         search.evaluate(float(e))
     if target == "line":
         # The line's azimuth and length again at the sweep's best eps', then the sweep
@@ -423,8 +438,9 @@ class _Search:
     bounded Gauss-Newton."""
 
     def __init__(self, pr: PointResponse, make: Callable[[float], Medium], lo: float, hi: float,
-                 hologram: Hologram) -> None:
+                 hologram: Hologram, bar: Any = None) -> None:
         self.pr, self.make, self.lo, self.hi = pr, make, lo, hi
+        self.bar = bar
         self.hologram = hologram
         self.lam = C0 / float(np.mean(hologram.frequencies))
         self.best: dict[float, tuple[float, float, np.ndarray]] = {}
@@ -539,13 +555,18 @@ class _Search:
         """
         if eps in self.best and not refine_shape:
             return self.best[eps]
+        if self.bar is not None:
+            if self.bar.n + 1 >= self.bar.total:
+                self.bar.total = self.bar.n + 4   # more than expected: keep room
+            self.bar.update()
         pr = self.pr
         floor = self.z0 + pr.spacing(eps) / 4
-        offset, xy0 = 0.0, self.xy
+        offset, xy0, close = 0.0, self.xy, False
         if self.best:  # start from the fit at the nearest eps' tried (a continuous path)
             near = min(self.best, key=lambda e: abs(np.log(e / eps)))
             _, z_near, xy0 = self.best[near]
             offset = z_near - self.paraxial_range(near)
+            close = abs(np.log(eps / near)) < 0.05
         # The object's range for this eps': near the range of the same paraxial curvature
         # (one frequency) or between it and the range of the same delay (several).
         z_c = self.paraxial_range(eps) + offset
@@ -560,6 +581,10 @@ class _Search:
             z_start, _ = max((pr.scan(eps, max(c - res, floor), max(c + res, floor + lam_m),
                                       xy0, samples=17) for c in centres),
                              key=lambda t: t[1])
+        elif close:
+            # One frequency, a neighbour within 5% of eps': its range moved along the
+            # paraxial curve is a start well inside the fit's basin (2 wavelengths wide).
+            z_start = max(z_c, floor)
         else:
             z_start, _ = pr.scan(eps, max(z_c - lam_m / 2, floor),
                                  max(z_c + lam_m / 2, floor + lam_m), xy0)
@@ -593,8 +618,8 @@ class _Search:
             hi_b = np.r_[hi_b, shape0[0] + 0.35, max(min(pr.max_length, 2 * L0), lam_m * 1.01)]
             p0[3:] = np.clip(p0[3:], lo_b[3:] + 1e-9, hi_b[3:] - 1e-9)
             scale = np.r_[scale, 0.02, self.lam / 10]
-        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-12,
-                            ftol=1e-15, gtol=1e-15, x_scale=scale)
+        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
+                            ftol=_FTOL, gtol=_FTOL, x_scale=scale)
         p = sol.x
         z = max(float(p[2]), floor)
         xy = np.r_[np.clip(p[:2], *pr.bounds), p[3:]]
@@ -619,8 +644,8 @@ class _Search:
         hi_b = np.array([*np.minimum(p0[:2] + 2 * lam_m, pr.bounds[1]), p0[2] + reach])
         lo_b[:2] = np.minimum(lo_b[:2], p0[:2] - 1e-9)
         hi_b[:2] = np.maximum(hi_b[:2], p0[:2] + 1e-9)
-        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=1e-10,
-                            ftol=1e-12, gtol=1e-12, x_scale=np.full(3, self.lam / 10))
+        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
+                            ftol=_FTOL, gtol=_FTOL, x_scale=np.full(3, self.lam / 10))
         z = max(float(sol.x[2]), floor)
         xy = np.r_[np.clip(sol.x[:2], *pr.bounds), shape]
         self.best[eps] = (pr.focus(eps, z, xy), z, xy)

@@ -62,7 +62,8 @@ from ..physics.vector_waves import vector_transfer
 
 __all__ = ["PointResponse"]
 
-_RHO_STEPS = 16   # radial samples per wavelength (in air; in the ground for a thin gap)
+_RHO_STEPS = 8    # radial samples per wavelength (in air; in the ground for a thin gap): 4-point
+#                  Lagrange of the demodulated functions, 3e-8 relative at 9.9 GHz
 _Z_STEPS = 8      # range samples per wavelength in the ground
 _Z_HALF = 6       # a window holds 2*_Z_HALF + 1 ranges (+- 0.75 wavelength)
 
@@ -379,10 +380,15 @@ class _Grid:
         self.amp, self.phase = np.abs(values), phase
         self.nz, self.nr = zs.size, rho.size
 
+    # The 4-point Lagrange weights on nodes -1, 0, 1, 2 as cubics in t: [1, t, t^2, t^3] @ C
+    # (-t(t-1)(t-2)/6, (t+1)(t-1)(t-2)/2, -(t+1)t(t-2)/2, (t+1)t(t-1)/6), one product.
+    _CUBIC = np.array([[0.0, 1.0, 0.0, 0.0], [-1 / 3, -1 / 2, 1.0, -1 / 6],
+                       [1 / 2, -1.0, 1 / 2, 0.0], [-1 / 6, 1 / 2, -1 / 2, 1 / 6]])
+
     @staticmethod
     def _weights(t: np.ndarray) -> np.ndarray:
-        return np.stack([-t * (t - 1) * (t - 2) / 6, (t + 1) * (t - 1) * (t - 2) / 2,
-                         -(t + 1) * t * (t - 2) / 2, (t + 1) * t * (t - 1) / 6], axis=-1)
+        t = np.asarray(t, float)
+        return (t[..., None] ** np.arange(4)) @ _Grid._CUBIC
 
     def __call__(self, z: float, rho: np.ndarray) -> np.ndarray:
         """Field at range ``z`` and distances ``rho``, shape (nf, len(rho))."""

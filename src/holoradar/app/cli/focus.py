@@ -48,6 +48,13 @@ def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
 @click.option("--fit", type=click.Choice(["field", "phase"]), default="field",
               show_default=True, help="Match the complex field, or its phases only (for "
                                       "arrays whose element amplitudes are not calibrated).")
+@click.option("--target", type=click.Choice(["point", "line"]), default="point",
+              show_default=True,
+              help="The object fitted: a compact one, or a horizontal bar or pipe (needs a "
+                   "polarised hologram and source; slow).")
+@click.option("--line-radius", default=0.006, show_default=True,
+              type=click.FloatRange(0, min_open=True), metavar="M",
+              help="The bar's radius for --target line, m.")
 @click.option("--confidence", default=0.95, show_default=True,
               type=click.FloatRange(0, 1, min_open=True, max_open=True))
 @click.option("--plot", "plot_file", default=None,
@@ -58,7 +65,8 @@ def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
 @output_options
 def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
               depth_range: str | None, position: str | None, glare: bool,
-              glare_estimate: str | None, fit: str, confidence: float, plot_file: Path | None,
+              glare_estimate: str | None, fit: str, target: str, line_radius: float,
+              confidence: float, plot_file: Path | None,
               force: bool, layout: str | None, check: bool, report: Reporter) -> None:
     """Find the ground permittivity that focuses a buried object best.
 
@@ -94,7 +102,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
                                  param_hint="--z-surface")
     res = run(holo, medium_model=medium, eps_range=eps_pair, depth_range=depth_pair,
               position=at, glare=glare_arg, fit=fit, confidence=confidence,
-              progress=report.progress)
+              target=target, line_radius=line_radius, progress=report.progress)
     files = []
     lines = [str(res)]
     if plot_file is not None:
@@ -110,12 +118,16 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
         "reason": res.reason, "position_m": res.position, "depth_m": res.depth,
         "range_interval_m": res.range_interval, "eps_focus": res.eps_focus,
         "eps_glare": res.eps_glare, "eps_glare_std": res.eps_glare_std,
-        "handle": res.handle, "focus_fraction": res.focus_fraction,
+        "handle": res.handle, "focus_fraction": res.focus_fraction, "target": target,
+        "line_azimuth_deg": res.line_azimuth_deg, "line_length_m": res.line_length,
         "evaluations": res.evaluations, "seconds": res.seconds, "files": files,
     }
     if res.position is not None:
         x, y, z = res.position
         lines.append(f"object at x={100 * x:.1f} y={100 * y:.1f} cm, range {100 * z:.1f} cm")
+    if res.line_azimuth_deg is not None and res.line_length is not None:
+        lines.append(f"line azimuth {res.line_azimuth_deg:.1f} deg from +x, length "
+                     f"{100 * res.line_length:.1f} cm")
     lines += [f"{res.eps_grid.size} trial eps', {res.evaluations} responses in "
               f"{res.seconds:.1f} s", *[f"wrote {f}" for f in files]]
     report.done(summary, lines)
