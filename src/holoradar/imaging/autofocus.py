@@ -40,17 +40,20 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-import scipy.fft as sfft
-from scipy.optimize import brentq, least_squares, minimize_scalar
-from scipy.stats import gamma, norm
-from tqdm.auto import tqdm
 
+from .._lazy import lazy_module
 from .._validate import AliasingWarning
 from ..analysis.noise import smooth_residual_energy
 from ..data.hologram import C0, Hologram
 from ..physics.medium import Medium
 from .migrate import migrate
 from .point_response import PointResponse
+
+# Imported on first use (holoradar._lazy): scipy.stats alone is several times numpy's
+# import, and `import holoradar` should cost little more than numpy.
+sfft = lazy_module("scipy.fft")
+_opt = lazy_module("scipy.optimize")
+_stats = lazy_module("scipy.stats")
 
 __all__ = ["AutofocusResult", "autofocus"]
 
@@ -162,7 +165,7 @@ class AutofocusResult:
 
 
 def _quantile(confidence: float) -> float:
-    return float(norm.ppf(0.5 + confidence / 2))
+    return float(_stats.norm.ppf(0.5 + confidence / 2))
 
 
 def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Medium],
@@ -298,6 +301,8 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     # Locating, the middle trial, the sweep, about 8 refinements and 6 for the interval
     # (a line: the sweep twice).
     expected = 2 + _COARSE * (2 if target == "line" else 1) + 14
+    from tqdm.auto import tqdm
+
     bar = tqdm(total=expected, desc="autofocus", unit="trial", disable=not progress,
                delay=1.0)
     search = _Search(pr, make, lo, hi, hologram, bar)
@@ -360,6 +365,9 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
              for j in range(len(grid)) if (j == 0 or F_grid[j] >= F_grid[j - 1])
              and (j == len(grid) - 1 or F_grid[j] >= F_grid[j + 1])]
     seeds += [(max(lo, c / 1.03), c, min(hi, c * 1.03)) for c in search.candidates()]
+    # Now the work left is known better: about 8 trials a refined seed, 7 for the interval.
+    bar.total = max(bar.total, bar.n + 8 * len(seeds) + 7)
+    bar.refresh()
     modes = []
     for a, c, b in seeds:
         F_c = search.evaluate(c)[0]
@@ -368,7 +376,7 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         if c in (lo, hi) or not a < c < b or 1 - F_c > 2 * (1 - best_so_far):
             modes.append(c)
             continue
-        minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
+        _opt.minimize_scalar(lambda le: -search.evaluate(float(np.exp(le)))[0],
                         bounds=(np.log(a), np.log(b)), method="bounded",
                         options={"xatol": 1e-3})
         modes.append(max((e for e in search.best if a <= e <= b),
@@ -534,7 +542,7 @@ class _Search:
             top = self.z0 + (P - self.z0) * 2 + 1e-3
             if m.optical_path(top).real < P or m.optical_path(self.z0).real > P:
                 continue
-            z = float(brentq(lambda z, P=P: m.optical_path(z).real - P, self.z0, top))
+            z = float(_opt.brentq(lambda z, P=P: m.optical_path(z).real - P, self.z0, top))
             if z > self.depths[1] + self.alias:
                 break
             out.append(z)
@@ -544,7 +552,7 @@ class _Search:
         """Range whose paraxial apparent distance is the located one."""
         m = self.make(eps)
         top = self.z0 + (self.A - self.z0) * np.sqrt(max(abs(e) for e in m.eps)) * 2 + 1e-3
-        return float(brentq(lambda z: m.apparent_distance(z) - self.A, self.z0, top))
+        return float(_opt.brentq(lambda z: m.apparent_distance(z) - self.A, self.z0, top))
 
     def evaluate(self, eps: float, refine_shape: bool = False) -> tuple[float, float, np.ndarray]:
         """Best focus fraction at ``eps`` with its range and lateral position.
@@ -618,7 +626,7 @@ class _Search:
             hi_b = np.r_[hi_b, shape0[0] + 0.35, max(min(pr.max_length, 2 * L0), lam_m * 1.01)]
             p0[3:] = np.clip(p0[3:], lo_b[3:] + 1e-9, hi_b[3:] - 1e-9)
             scale = np.r_[scale, 0.02, self.lam / 10]
-        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
+        sol = _opt.least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
                             ftol=_FTOL, gtol=_FTOL, x_scale=scale)
         p = sol.x
         z = max(float(p[2]), floor)
@@ -644,7 +652,7 @@ class _Search:
         hi_b = np.array([*np.minimum(p0[:2] + 2 * lam_m, pr.bounds[1]), p0[2] + reach])
         lo_b[:2] = np.minimum(lo_b[:2], p0[:2] - 1e-9)
         hi_b[:2] = np.maximum(hi_b[:2], p0[:2] + 1e-9)
-        sol = least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
+        sol = _opt.least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
                             ftol=_FTOL, gtol=_FTOL, x_scale=np.full(3, self.lam / 10))
         z = max(float(sol.x[2]), floor)
         xy = np.r_[np.clip(sol.x[:2], *pr.bounds), shape]
@@ -669,7 +677,7 @@ class _Search:
         def f(e: float) -> float:
             return self.evaluate(float(e))[0] - level
 
-        return float(brentq(f, inside, outside, rtol=1e-3))
+        return float(_opt.brentq(f, inside, outside, rtol=1e-3))
 
     def statistics(self, eps: float, z: float, xy: np.ndarray) -> dict[str, float]:
         """Noise variance, detection statistic and sandwich factor at the optimum."""
@@ -684,7 +692,7 @@ class _Search:
         s2f = max(float(np.vdot(rf, rf).real) / max(2 * n_complex - 4 - 2 * n_amp, 1), floor)
         detection = pr.energy * pr.match(gf, phase=False)[0] / (2 * s2f)
         # With one amplitude per frequency the output sums n_amp such variables (Gamma).
-        threshold = float(gamma.isf(_FALSE_ALARM / self.trials, n_amp))
+        threshold = float(_stats.gamma.isf(_FALSE_ALARM / self.trials, n_amp))
         # Residual variance per real component: a phase-only residual has one real
         # component per sample (along the phase), a field residual two.
         r, g, a = pr.residual(eps, z, xy)
