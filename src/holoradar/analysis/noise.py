@@ -13,9 +13,11 @@ aperture's truncated edges leak no signal there).
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from ..data.hologram import Hologram
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["estimate_snr", "smooth_residual_energy"]
 

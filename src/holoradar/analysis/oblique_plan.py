@@ -31,7 +31,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..data.hologram import C0
 from ..physics.medium import Medium
@@ -260,6 +259,8 @@ def _refracted_ray(medium: Medium, c: np.ndarray, tgt: np.ndarray
                    ) -> tuple[np.ndarray, float, float]:
     """Ray from ``c`` (air) to ``tgt`` (ground) through the layers: where it crosses
     the surface, and its sagittal and tangential apparent distances (metres)."""
+    from scipy.optimize import brentq  # here, not at import: holoradar._lazy
+
     m_t = int(medium.region_of(tgt[2]))
     tops = [float(c[2])] + [medium.z_interfaces[m] for m in range(m_t)]
     bottoms = [*tops[1:], float(tgt[2])]

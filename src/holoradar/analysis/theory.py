@@ -9,13 +9,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
-from scipy.special import fresnel
 
+from .._lazy import lazy_module
 from .._validate import as_real, check_frequency
 from ..data.hologram import C0
 from ..physics.medium import _check_eps
 from ..physics.medium import fresnel as _interface_fresnel
+
+# Imported on first use (holoradar._lazy): `import holoradar` should cost little more
+# than numpy.
+_opt = lazy_module("scipy.optimize")
+_special = lazy_module("scipy.special")
 
 __all__ = [
     "SpectralWindow",
@@ -159,7 +163,7 @@ def lateral_resolution(wavelength: float, distance: float, aperture: float) -> f
 def _fresnel_amplitude(w: np.ndarray | float) -> np.ndarray:
     """|∫_{-a}^{a} exp(i*psi*x^2) dx| / (2a) as a function of w = a*sqrt(2*psi/pi)."""
     w = np.asarray(w, float)
-    S, C = fresnel(w)
+    S, C = _special.fresnel(w)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(w > 0, np.hypot(C, S) / np.where(w > 0, w, 1), 1.0)
 
@@ -193,7 +197,7 @@ def longitudinal_resolution(wavelength: float, distance: float, aperture: float,
         return float((_fresnel_amplitude(wx) * _fresnel_amplitude(wy)) ** 2 - 0.5)
 
     hi = 8 * wavelength * (distance / min(a, b)) ** 2
-    return 2 * brentq(half, 1e-12 * hi, hi)
+    return 2 * _opt.brentq(half, 1e-12 * hi, hi)
 
 
 def focal_shift(wavelength: float, distance: float, aperture: float, *,
@@ -222,8 +226,9 @@ def focal_shift(wavelength: float, distance: float, aperture: float, *,
         return -float(_fresnel_amplitude(a * s) * _fresnel_amplitude(b * s) / z)
 
     span = longitudinal_resolution(wavelength, distance, aperture, aperture_y=aperture_y)
-    res = minimize_scalar(neg_amp, bounds=(max(distance - span, distance / 4), distance + 1e-9),
-                          method="bounded", options={"xatol": 1e-7})
+    res = _opt.minimize_scalar(neg_amp,
+                               bounds=(max(distance - span, distance / 4), distance + 1e-9),
+                               method="bounded", options={"xatol": 1e-7})
     return float(res.x - distance)
 
 

@@ -27,11 +27,15 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
+from .._lazy import lazy_module
 from ..data.hologram import Hologram
 from ._arrays import complex_field, element_mask
+
+# Imported on first use (holoradar._lazy): `import holoradar` should cost little more
+# than numpy.
+sp = lazy_module("scipy.sparse")
+spla = lazy_module("scipy.sparse.linalg")
 
 __all__ = ["BadElements", "find_bad_elements", "interpolate_for_display"]
 

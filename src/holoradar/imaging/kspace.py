@@ -28,8 +28,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import (
@@ -40,6 +40,8 @@ from ..physics.propagation import (
     two_way_transfer,
 )
 from ..physics.sources import PlaneWave
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 _CHUNK = 8      # planes per inverse-FFT batch (memory: _CHUNK padded planes)
 _BLOCK = 2048   # spectral components per cache block of the recurrence

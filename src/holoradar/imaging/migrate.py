@@ -14,9 +14,8 @@ from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
-import scipy.fft as sfft
-from tqdm.auto import tqdm
 
+from .._lazy import lazy_module
 from .._threads import POOL_SIZE, pool
 from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
 from ..analysis.noise import estimate_snr
@@ -32,6 +31,8 @@ from ..physics.propagation import (
 )
 from ..physics.sources import PlaneWave
 from . import kspace, oblique
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["IlluminationWarning", "migrate"]
 
@@ -267,7 +268,11 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     show = zs.size * oy * ox * max(1, int(np.prod(batch))) > 2e8 if progress is None \
         else progress
     # delay: a bar only for work that lasts (progress=True shows it after a second)
-    bar = tqdm(total=zs.size, desc="migrate", unit="plane", delay=1.0) if show else None
+    bar = None
+    if show:
+        from tqdm.auto import tqdm  # here, not at import: holoradar._lazy
+
+        bar = tqdm(total=zs.size, desc="migrate", unit="plane", delay=1.0)
     chunk = zs.size if in_place else _CHUNK
     for c0 in range(0, zs.size, chunk):
         Ucs = op.adjoint_transfers[c0:c0 + chunk]

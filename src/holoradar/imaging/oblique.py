@@ -36,8 +36,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from .._validate import as_axis, uniform_step
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
@@ -50,6 +50,8 @@ from ..physics.propagation import (
     spectral_axes,
 )
 from .kspace import _pad_axis
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 _EVANESCENT_FLOOR = 1e-8
 

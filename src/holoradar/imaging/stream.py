@@ -20,8 +20,8 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram, Image
 from ..physics.incident import incident_on_plane
@@ -31,6 +31,8 @@ from ..physics.sources import PointSource
 from .glare import FitWarning, _direct_wave, suppress_surface
 from .migrate import _zero_pad_spectrum
 from .synthesis import _check_views
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["StreamImager"]
 

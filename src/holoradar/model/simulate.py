@@ -37,7 +37,6 @@ Against a direct Rayleigh-Sommerfeld sum the field agrees to about 0.1%.
 from __future__ import annotations
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from .._validate import as_polarization, as_real, check_frequency
 from ..data.hologram import C0, Hologram, _frequency_axis, has_polarization
@@ -161,6 +160,8 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
                          "targets, e.g. a grid of them over the object")
     rng = np.random.default_rng(seed)
     rows = []
+    from tqdm.auto import tqdm  # here, not at import: holoradar._lazy
+
     for f in tqdm(freqs, desc="simulate", unit="frequency", disable=not progress, delay=1.0):
         k = 2 * np.pi * f / C0
         if vector and mono:

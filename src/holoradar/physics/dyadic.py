@@ -64,7 +64,6 @@ from __future__ import annotations
 import hashlib
 
 import numpy as np
-from scipy.special import j1
 
 from .green import _nodes, _phase_length
 from .medium import Medium
@@ -455,6 +454,8 @@ def _kernels_many(k: float, medium: Medium, kap: np.ndarray, z_src: float,
 def _bessel_j12(rho: np.ndarray, kappa: np.ndarray, J0: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray]:
     """``J1`` and ``J2`` of ``rho kappa``, kept for reuse beside the scalar field's ``J0``."""
+    from scipy.special import j1  # here, not at import: holoradar._lazy
+
     from .green import _J0_CACHE
 
     digest = hashlib.blake2b(rho.tobytes() + b"|J12|" + kappa.tobytes(), digest_size=16).digest()

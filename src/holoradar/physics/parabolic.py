@@ -33,9 +33,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from .medium import Medium
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["ParabolicEquation"]
 

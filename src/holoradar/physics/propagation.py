@@ -29,9 +29,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.fft as sfft
 
+from .._lazy import lazy_module
 from .medium import Medium
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = [
     "DEFAULT_SNR_DB",

@@ -11,7 +11,6 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Sequence
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import nullcontext
 from typing import Any
 
@@ -82,6 +81,9 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
     raised here.
     """
     if scheduler in LOCAL:
+        # Here, not at import: concurrent.futures.process brings in multiprocessing.
+        from concurrent.futures.process import BrokenProcessPool
+
         import dask
         from dask.diagnostics import ProgressBar
 

@@ -12,12 +12,16 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq, least_squares
 
+from ..._lazy import lazy_module
 from ...data.hologram import Hologram
 from ...physics.medium import Medium
 from ...physics.sources import PointSource
 from ._common import _linear_fit
+
+# Imported on first use (holoradar._lazy): `import holoradar` should cost little more
+# than numpy.
+_opt = lazy_module("scipy.optimize")
 
 
 def _csp_beam(k: float, pts: np.ndarray, x: float, y: float, z: float, b: float,
@@ -84,8 +88,8 @@ def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None
     b_max = k * (2 * np.pi / k) ** 2 / 2 if b0 is None else 4 * b0
     lo = np.array([-3.0, -3.0, (-x0[2] if b0 is None else 0.25 * b0 - x0[2]) / scale])
     hi = np.array([3.0, 3.0, (b_max - x0[2]) / scale])
-    sol = least_squares(resid, np.clip(np.zeros(3), lo, hi), bounds=(lo, hi), xtol=1e-10,
-                        ftol=1e-12, max_nfev=400)
+    sol = _opt.least_squares(resid, np.clip(np.zeros(3), lo, hi), bounds=(lo, hi), xtol=1e-10,
+                             ftol=1e-12, max_nfev=400)
     theta = x0 + sol.x * scale
     theta[2] = abs(theta[2])
     coef, _, G = parts(theta)
@@ -138,4 +142,4 @@ def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
 
     if excess(1.0 + 1e-9) >= 0 or excess(1e4) <= 0:
         return complex(V), complex(np.nan)
-    return complex(V), complex(brentq(excess, 1.0 + 1e-9, 1e4, xtol=1e-10))
+    return complex(V), complex(_opt.brentq(excess, 1.0 + 1e-9, 1e4, xtol=1e-10))

@@ -13,11 +13,15 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import scipy.fft as sfft
-from scipy.optimize import least_squares
 
+from ..._lazy import lazy_module
 from ...physics.medium import Medium
 from ...physics.sources import PointSource
+
+# Imported on first use (holoradar._lazy): `import holoradar` should cost little more
+# than numpy.
+sfft = lazy_module("scipy.fft")
+_opt = lazy_module("scipy.optimize")
 
 
 def _sandwich_std(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
@@ -128,8 +132,8 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
         return np.concatenate([r.real, r.imag])
 
     e_start = np.array([eps0.real, max(eps0.imag, 0.0)])
-    sol = least_squares(resid, e_start, x_scale=np.array([0.1, 0.01]) * max(e_start[0], 1.0),
-                        bounds=([1e-3, 0.0], [np.inf, np.inf]), xtol=1e-12, max_nfev=200)
+    sol = _opt.least_squares(resid, e_start, x_scale=np.array([0.1, 0.01]) * max(e_start[0], 1.0),
+                             bounds=([1e-3, 0.0], [np.inf, np.inf]), xtol=1e-12, max_nfev=200)
     a, G, _ = parts(sol.x)
     noise_std = _sandwich_std(sol.fun, sol.jac, th.shape)
     bias = _model_error_bound(sol.fun, sol.jac, th.shape)

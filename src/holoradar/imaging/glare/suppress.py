@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-import scipy.fft as sfft
 
+from ..._lazy import lazy_module
 from ...analysis.theory import lateral_resolution
 from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
@@ -25,6 +25,8 @@ from ...physics.sources import GaussianBeam, PointSource
 from ._common import _direct_wave, _joint_direct, _recorded
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["FitWarning", "SuppressionReport", "suppress_surface"]
 

@@ -1,0 +1,78 @@
+"""Start-up: ``import holoradar`` and ``holoradar --help``/``--version`` load no heavy module.
+
+Each check runs in a fresh interpreter (this one has long since imported everything).
+The modules named are those that cost the most when imported beside numpy (README,
+"Start-up"; ``benchmarks/bench_startup.py`` times the whole). Speed itself is
+measured there, never asserted here.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+# Each of these costs from about 0.05 s (h5py) to 1 s (scipy.stats) on top of numpy.
+HEAVY = ("scipy.fft", "scipy.special", "scipy.optimize", "scipy.interpolate", "scipy.stats",
+         "scipy.sparse", "scipy.linalg", "scipy.ndimage", "tqdm", "xarray", "dask",
+         "distributed", "bokeh", "matplotlib", "h5py", "zarr")
+
+
+def _loaded_after(code: str) -> list[str]:
+    """The heavy modules (and ``importlib.metadata``) in ``sys.modules`` after ``code``."""
+    probe = textwrap.dedent(code) + textwrap.dedent(f"""
+        import json, sys
+        watched = {(*HEAVY, "importlib.metadata")!r}
+        print(json.dumps(sorted(m for m in watched if m in sys.modules)))
+        """)
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, timeout=120).stdout
+    return json.loads(out.splitlines()[-1])
+
+
+def test_import_holoradar_loads_no_heavy_module():
+    assert _loaded_after("import holoradar") == []
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"], ["view", "--help"],
+                                  ["autofocus", "--help"]])
+def test_cli_help_and_version_load_no_heavy_module(argv):
+    # The command line as the `holoradar` script runs it, stopped where click exits.
+    # --version states the version it was given: importlib.metadata is not needed.
+    loaded = _loaded_after(f"""
+        import contextlib, io, sys
+        sys.argv = ["holoradar", *{argv!r}]
+        from holoradar.app.cli import main
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):
+            main()
+        """)
+    assert loaded == []
+
+
+def test_lazy_module_imports_on_first_use_and_computes_as_before():
+    # The proxy imports scipy.fft on the first attribute read, and the call is scipy's own.
+    out = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import sys
+        import numpy as np
+        from holoradar.physics import propagation
+        before = "scipy.fft" in sys.modules
+        shape = propagation.padded_shape((100, 97), True, pitch=(0.01, 0.01))
+        import scipy.fft
+        same = shape == tuple(scipy.fft.next_fast_len(2 * n, real=False) for n in (100, 97))
+        print(before, "scipy.fft" in sys.modules, same, repr(propagation.sfft))
+        """)], capture_output=True, text=True, check=True, timeout=120).stdout.split()
+    assert out[:3] == ["False", "True", "True"]
+    assert "<module 'scipy.fft'>" in " ".join(out[3:])
+
+
+def test_version_option_states_the_package_version():
+    from click.testing import CliRunner
+
+    import holoradar
+    from holoradar.app.cli import main
+
+    result = CliRunner().invoke(main, ["--version"], prog_name="holoradar")
+    assert result.output.strip() == f"holoradar, version {holoradar.__version__}"
