@@ -23,11 +23,12 @@ from .data.wideband import apply_calibration, conjugate, remove_mean
 from .imaging.autofocus import AutofocusResult, autofocus
 from .imaging.glare import (
     FitWarning,
+    GlareWarning,
     SuppressionReport,
     estimate_permittivity,
     suppress_surface,
 )
-from .imaging.iq import iq_convention
+from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
 from .imaging.migrate import IlluminationWarning, migrate
 from .imaging.stream import StreamImager
 from .imaging.synthesis import align_phases, synthesize
@@ -53,7 +54,9 @@ __all__ = [
     "FitWarning",
     "Fresnel",
     "GaussianBeam",
+    "GlareWarning",
     "Hologram",
+    "IQSignWarning",
     "IlluminationWarning",
     "Image",
     "LineTarget",
@@ -73,6 +76,7 @@ __all__ = [
     "apply_calibration",
     "autofocus",
     "calibrate",
+    "check_iq_sign",
     "conjugate",
     "estimate_permittivity",
     "iq_convention",

@@ -1,16 +1,27 @@
 """Which I/Q sign a device delivers, told from the data themselves.
 
 holoradar reads a complex sample as ``I + iQ`` of a field under ``exp(-i*omega*t)``.
-A device whose Q has the other sign (or that mixes with the other sideband)
-delivers the complex conjugate. The two are told apart by physics: with the right
-sign the scene focuses in front of the aperture; the conjugate is the field of
-the mirror scene behind it, so back-propagated to the same ranges it spreads out
-instead. The image with the sharper focus (larger peak-to-mean intensity) wins.
+A device whose Q has the other sign (the engineering convention ``exp(+j*omega*t)``,
+``I - jQ``, or a mixer on the other sideband) delivers the complex conjugate. The
+two are told apart by physics: with the right sign the scene focuses in front of
+the aperture; the conjugate is the field of the mirror scene behind it, so
+back-propagated to the same ranges it spreads out instead. The image with the
+sharper focus (larger peak-to-mean intensity) wins.
+
+:func:`iq_convention` always answers; :func:`check_iq_sign` answers only when the
+difference is decisive (otherwise ``None``), cheaply (a few planes and
+frequencies), and :func:`warn_if_conjugated` turns a decisive ``"I-iQ"`` into an
+:class:`IQSignWarning` that names the fix. :func:`holoradar.load` calls it on a
+device's file whose layout does not declare ``iq_sign``, and ``holoradar image``
+at the ranges and through the ground it images.
 """
 
 from __future__ import annotations
 
+import warnings
+import weakref
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -19,12 +30,164 @@ from ..data.hologram import Hologram
 from ..data.wideband import conjugate
 from .migrate import migrate
 
-__all__ = ["iq_convention"]
+__all__ = ["IQSignCheck", "IQSignWarning", "check_iq_sign", "iq_convention",
+           "warn_if_conjugated"]
+
+DECISIVE_RATIO = 3.0
+"""How much sharper (peak-to-mean intensity) one side must focus than the other for
+:func:`check_iq_sign` to decide. Data in which nothing focuses are speckle on both
+sides: the peak-to-mean intensity of N independent cells is ``ln N + 0.58`` with a
+spread of 1.28 (the Gumbel law of the largest of N exponential intensities), so one
+side reaches 3 times the other's ``ln N + 0.58`` with probability about
+``exp(-2 ln N - 1.2) = 0.3/N^2``: below 1e-3 from N = 18 cells on. A focused point
+is tens to hundreds of times sharper than its conjugate (tests/test_iq_sign.py)."""
+
+PAD = 2.0
+"""Zero padding of the check's images: one grid for every frequency, so that their
+intensities add."""
+
+MAX_PLANES = 8
+"""Planes the check images on each side (spread over the ranges given)."""
+
+MAX_FREQUENCIES = 4
+"""Frequencies the check images (spread over the band); each is imaged alone and the
+intensities add, so a device's phase response across the band does not matter."""
+
+
+class IQSignWarning(UserWarning):
+    """The data focus behind the array: recorded as ``I - iQ`` (their complex conjugate)."""
+
+
+@dataclass(frozen=True)
+class IQSignCheck:
+    """What :func:`check_iq_sign` found.
+
+    Attributes
+    ----------
+    sign : {"I+iQ", "I-iQ"} or None
+        The convention the data follow, or None when the two sides focus alike
+        (nothing compact in the ranges looked at, or mostly noise).
+    ratio : float
+        Peak-to-mean intensity of the data as recorded over that of their
+        conjugate (the mirror scene behind the aperture): >> 1 for ``I + iQ``,
+        << 1 for ``I - iQ``.
+    z : tuple of float
+        The ranges imaged, metres.
+    """
+
+    sign: Literal["I+iQ", "I-iQ"] | None
+    ratio: float
+    z: tuple[float, ...]
 
 
 def _sharpness(data: np.ndarray) -> float:
     a = np.abs(data) ** 2
     return float(a.max() / max(a.mean(), 1e-300))
+
+
+def _spread(values: np.ndarray, n: int) -> np.ndarray:
+    """At most ``n`` of ``values``, evenly spread and including both ends."""
+    if values.size <= n:
+        return values
+    return values[np.unique(np.round(np.linspace(0, values.size - 1, n)).astype(int))]
+
+
+def _without_direct_wave(hologram: Hologram) -> Hologram:
+    """The data less their part along the radiator's direct wave and its conjugate.
+
+    A horn just behind the array sends its own wave into the elements, often the
+    strongest part of the data: it focuses behind the array, on the horn, so its
+    conjugate focuses in front and blurs the comparison. Removing both the wave
+    and its conjugate (least squares, free complex amplitudes) treats the two
+    conventions alike. Without a known point radiator the data stay as they are.
+    """
+    from .glare._common import Radiator, _direct_wave, _recorded
+
+    src = hologram.source
+    if hologram.monostatic or not isinstance(src, Radiator):  # a plane wave: no focus
+        return hologram
+    shape = hologram.data.shape
+    D = _direct_wave(src, hologram.k, hologram.points, _recorded(hologram, src))
+    basis = np.stack([D, np.conj(D)], axis=1)
+    d = hologram.data.reshape(-1, D.size).T
+    coef, *_ = np.linalg.lstsq(basis, d, rcond=None)
+    return hologram.with_data((d - basis @ coef).T.reshape(shape))
+
+
+def default_ranges(hologram: Hologram) -> np.ndarray:
+    """Ranges where a scene in front of an aperture of width A focuses: A/4 to 2A, metres.
+
+    Nearer than A/4 the radiator's own wave may focus (a horn just behind the
+    array: its conjugate focuses as far in front); beyond 2A an aperture's focus
+    is too long in range to stand out.
+    """
+    a = max(hologram.aperture_size)
+    return np.geomspace(a / 4, 2 * a, MAX_PLANES)
+
+
+def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | None = None,
+                  **migrate_options: Any) -> IQSignCheck:
+    """Whether the data focus in front of the aperture (``I + iQ``) or behind it (``I - iQ``).
+
+    Back-propagates the data and their conjugate (the field of the mirror scene
+    behind the aperture) to the same ranges and compares the sharpness of their
+    foci; decides only when one is :data:`DECISIVE_RATIO` times sharper. Cheap:
+    at most :data:`MAX_PLANES` planes and :data:`MAX_FREQUENCIES` frequencies, one
+    pixel per element.
+
+    Parameters
+    ----------
+    hologram : Hologram
+        One or several frequencies (each imaged alone, intensities added).
+    z : float or sequence of float, optional
+        Ranges where the scene is, metres (the planes of an image to be made);
+        default :func:`default_ranges` in free space.
+    **migrate_options
+        Passed to :func:`holoradar.migrate` (``medium=``, ``frame=``).
+
+    Returns
+    -------
+    IQSignCheck
+        ``sign`` None when undecided, or when the hologram cannot be imaged so.
+
+    Examples
+    --------
+    >>> import holoradar as hr
+    >>> ap = hr.Aperture.grid(32, 0.0125)
+    >>> h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))]), ap, 9.9e9)
+    >>> check_iq_sign(h).sign, check_iq_sign(conjugate(h)).sign
+    ('I+iQ', 'I-iQ')
+    """
+    try:
+        zs = default_ranges(hologram) if z is None else np.atleast_1d(np.asarray(z, float))
+        zs = _spread(np.unique(zs), MAX_PLANES)
+        opts = {k: v for k, v in migrate_options.items() if k in ("medium", "frame", "method")}
+        # The whole padded grid: the glare's focus (the horn's mirror image) often lies
+        # beside the array, and it focuses in front as any scatterer does. A level
+        # ground frame images the footprint only.
+        opts["fov"] = "aperture" if opts.get("frame") == "ground" else "full"
+        views = [_without_direct_wave(hologram.at_frequency(int(i)))
+                 for i in _spread(np.arange(hologram.nf), MAX_FREQUENCIES)]
+        sides = []
+        for flip in (False, True):
+            total: Any = 0.0
+            for h in views:
+                with warnings.catch_warnings():
+                    # the aliasing of the pitch and the like: the user's own imaging says so
+                    warnings.simplefilter("ignore")
+                    img = migrate(conjugate(h) if flip else h, zs, upsample=1, pad=PAD,
+                                  progress=False, **opts)
+                total = total + np.abs(img.data) ** 2
+            sides.append(_sharpness(np.sqrt(total)))
+    except ValueError:  # a grid or geometry the imaging refuses: no verdict
+        return IQSignCheck(None, float("nan"), ())
+    ratio = sides[0] / max(sides[1], 1e-300)
+    sign: Literal["I+iQ", "I-iQ"] | None = None
+    if ratio >= DECISIVE_RATIO:
+        sign = "I+iQ"
+    elif ratio <= 1 / DECISIVE_RATIO:
+        sign = "I-iQ"
+    return IQSignCheck(sign, float(ratio), tuple(float(v) for v in zs))
 
 
 def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
@@ -59,3 +222,79 @@ def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
     as_is = _sharpness(migrate(hologram, z, **migrate_options).data)
     flipped = _sharpness(migrate(conjugate(hologram), z, **migrate_options).data)
     return "I+iQ" if as_is >= flipped else "I-iQ"
+
+
+def conjugated_message(result: IQSignCheck, what: str = "hologram",
+                       fix: str | None = None) -> str:
+    """The warning's text for a decisive ``"I-iQ"`` of :func:`check_iq_sign`."""
+    zs = result.z
+    where = (f"{zs[0] * 100:.0f} cm" if len(zs) == 1
+             else f"{zs[0] * 100:.0f}-{zs[-1] * 100:.0f} cm")
+    fix = fix or ("declare iq_sign=I-iQ in the layout when loading, or image "
+                  "hr.conjugate(hologram)")
+    return (f"{what}: the data focus behind the array, not in front (their complex "
+            f"conjugate focuses {1 / result.ratio:.1f} times sharper at {where}): they look "
+            "recorded as I - iQ, the engineering convention exp(+j omega t), and holoradar, "
+            "which reads I + iQ under exp(-i omega t), images them as a blur. Fix: " + fix)
+
+
+# The data arrays already warned about (id -> weak reference, result): a hologram that
+# load() warned about is not warned about again by the imaging that follows.
+_WARNED: dict[int, tuple[Any, IQSignCheck]] = {}
+
+
+def _remember(data: np.ndarray, result: IQSignCheck) -> None:
+    key = id(data)
+    try:
+        ref = weakref.ref(data, lambda _: _WARNED.pop(key, None))
+    except TypeError:  # an object without weak references: nothing remembered
+        return
+    _WARNED[key] = (ref, result)
+
+
+def _warned(data: np.ndarray) -> IQSignCheck | None:
+    entry = _WARNED.get(id(data))
+    return entry[1] if entry is not None and entry[0]() is data else None
+
+
+def warn_if_conjugated(hologram: Hologram, z: float | Sequence[float] | np.ndarray | None = None,
+                       *, what: str = "hologram", fix: str | None = None, stacklevel: int = 2,
+                       **migrate_options: Any) -> IQSignCheck:
+    """:func:`check_iq_sign`, warning (:class:`IQSignWarning`) when it decides ``"I-iQ"``.
+
+    Parameters
+    ----------
+    hologram, z, **migrate_options
+        As for :func:`check_iq_sign`.
+    what : str
+        How the message names the data (a file name).
+    fix : str, optional
+        The remedy the message names (default: the layout's ``iq_sign=I-iQ`` or
+        :func:`holoradar.conjugate`).
+    stacklevel : int
+        Of the warning, counted from the caller of this function.
+
+    Returns
+    -------
+    IQSignCheck
+
+    Examples
+    --------
+    >>> import warnings, holoradar as hr
+    >>> ap = hr.Aperture.grid(32, 0.0125)
+    >>> h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))]), ap, 9.9e9)
+    >>> with warnings.catch_warnings(record=True) as said:
+    ...     warnings.simplefilter("always")
+    ...     _ = warn_if_conjugated(conjugate(h))
+    >>> said[0].category.__name__
+    'IQSignWarning'
+    """
+    said = _warned(hologram.data)
+    if said is not None:  # warned about already (by load): once is enough
+        return said
+    result = check_iq_sign(hologram, z, **migrate_options)
+    if result.sign == "I-iQ":
+        warnings.warn(conjugated_message(result, what, fix), IQSignWarning,
+                      stacklevel=stacklevel + 1)
+        _remember(hologram.data, result)
+    return result

@@ -95,7 +95,10 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     check : bool
         Refuse a hologram whose numbers look like a unit mistake (pitch against
         wavelength, a frequency in GHz, all zeros): see
-        :func:`~holoradar.data.plausibility.check_plausible`.
+        :func:`~holoradar.data.plausibility.check_plausible`. For a user's file
+        whose layout does not declare ``iq_sign``, also check the I/Q sign
+        (:func:`~holoradar.imaging.iq.check_iq_sign`, a few milliseconds for a
+        16 x 16 array).
 
     Raises
     ------
@@ -103,6 +106,13 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
         The file is missing, empty, truncated or damaged, holds a pickled object
         array, lacks a variable (the message lists what it holds and what is
         needed), or looks like a unit mistake.
+
+    Warns
+    -----
+    IQSignWarning
+        A user's file whose data focus behind the array, not in front: recorded
+        as ``I - iQ`` (the engineering convention), with the fix (``iq_sign=I-iQ``
+        in the layout, or :func:`holoradar.conjugate`).
 
     Examples
     --------
@@ -126,6 +136,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     src = Path(path)
     lay = _as_layout(layout)
     obj = None
+    device = False
     if src.suffix.lower() in NETCDF_SUFFIXES and lay is None:
         try:  # holoradar's own file, read in one pass (a survey reads thousands)
             obj = read_direct(src)
@@ -146,9 +157,20 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
         else:
             full = (side_layout or Layout()).merged(lay)
             obj = assemble(variables, full, what=src.name)
+            device = "iq_sign" not in full.given
     if check and isinstance(obj, Hologram):
         check_plausible(obj, what=src.name)
+        if device:
+            # A device's own export whose layout does not say its I/Q sign: data in the
+            # engineering convention (I - jQ) would image as a blur without a word.
+            from ..imaging.iq import warn_if_conjugated
+
+            warn_if_conjugated(obj, what=src.name, fix=_IQ_FIX, stacklevel=2)
     return obj
+
+
+_IQ_FIX = ("declare it in the layout, iq_sign=I-iQ (holoradar --layout '...,iq_sign=I-iQ', "
+           "hr.load(path, layout='...,iq_sign=I-iQ')), or image hr.conjugate(hologram)")
 
 
 def _npz_image(v: dict[str, np.ndarray], what: str) -> Image:

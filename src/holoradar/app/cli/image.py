@@ -83,6 +83,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
     from ...analysis.metrics import peak_position
     from ...imaging.migrate import migrate
     from ...io.output import check_output
+    from .checks import check_image
 
     zs = depth_ranges(z)
     # Outputs are checked before any work: never an input, never replaced unasked.
@@ -98,6 +99,9 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
                   progress=report.progress)
     seconds = time.perf_counter() - t0
     pk = peak_position(img)
+    # data in the other I/Q convention, a picture of the glare: said, with the fix
+    check_image(hologram_file, holo, img, medium, medium_spec, zs, layout=layout,
+                method=method, frame=frame, upsample=upsample)
     ground = None if medium is None else {"z_interfaces": list(medium.z_interfaces),
                                            "eps": [str(e) for e in medium.eps]}
     history = [*input_history(hologram_file, layout), {

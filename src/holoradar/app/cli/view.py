@@ -51,10 +51,11 @@ def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[s
                    "opened when no FILES are given).")
 @click.option("--depth", type=float, default=None,
               help="First depth below the surface (range without a ground), m; default: "
-                   "for holograms the brightest plane of the sweep, for an image its middle "
-                   "plane, for a survey its first.")
+                   "for holograms the brightest plane of the sweep (glare removed, see "
+                   "--glare), for an image its middle plane, for a survey its first.")
 @click.option("--glare", type=click.Choice(["off", "gaussian", "image_source", "cut"]),
-              default=None, help="Glare suppression to start with (default off).")
+              default=None, help="Glare suppression to start with; default: gaussian for "
+                                 "holograms with a ground and a known horn, else off.")
 @click.option("--host", default="127.0.0.1", show_default=True,
               help="Address to serve on. Anything but the loopback shows the data to the "
                    "network (a warning says so).")
@@ -119,10 +120,10 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         if s.sweep is not None and not s.sweep[0] <= depth <= s.sweep[1]:
             # the slider spans the sweep: widen it to the depth asked for
             s = s.replace(sweep=(min(s.sweep[0], depth), max(s.sweep[1], depth)))
-    elif base is None and session.kind == "holograms":
-        from ...analysis.metrics import peak_position
-
-        s = s.replace(depth=float(peak_position(session.sweep(s))[2] - session.surface(s)))
+    if base is None:
+        # the object rather than the glare: its suppression on where it can be done, the
+        # brightest point's depth, unless asked otherwise
+        s = session.opening_settings(s, glare=glare is None, depth=depth is None)
     session.medium(s)  # a bad ground fails here, before the server starts
     server = _serve(session, s, host, port, export_dir)
     url = url_of(server, host)

@@ -220,6 +220,68 @@ class ViewSession:
                           depth=float(z[0]), planes=max(2, int(z.size)))
         return s.replace(**changes)
 
+    def opening_settings(self, s: ViewSettings, *, glare: bool = True,
+                         depth: bool = True) -> ViewSettings:
+        """The look the viewer opens with: the object, not the glare.
+
+        Raw holograms over ground are mostly the surface glare (the horn's
+        reflection): its speckle fills the planes near the surface and its focus
+        is the brightest point of the sweep. So, for holograms, the glare is
+        removed (the Gaussian-beam fit, the fast one) when it can be: the look
+        has a ground, every view's radiator is known and point-like (a horn, a
+        dipole, a Gaussian beam) and every fit succeeds; and the depth is that of
+        the brightest point of the sweep so imaged.
+
+        Parameters
+        ----------
+        s : ViewSettings
+            The look so far (:meth:`default_settings`, with what the user gave).
+        glare : bool
+            Choose the glare suppression (False: the user chose it).
+        depth : bool
+            Choose the depth (False: the user gave one).
+
+        Returns
+        -------
+        ViewSettings
+            ``s`` for an image or a survey.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import holoradar as hr
+        >>> d = pathlib.Path(tempfile.mkdtemp())
+        >>> sand = hr.Medium.half_space(0.3, 2.5)
+        >>> scene = hr.Scene(sand, hr.PointSource((0.0, -0.2, -0.05)),
+        ...                  [hr.PointTarget((0.0, 0.0, 0.4), 0.05)])
+        >>> p = hr.save(hr.simulate(scene, hr.Aperture.grid(16, 0.025), 9.9e9), d / "h.nc")
+        >>> session = ViewSession([p])
+        >>> look = session.opening_settings(session.default_settings({"surface": 0.3,
+        ...                                                          "eps": 2.5}))
+        >>> look.glare, bool(0.0 < look.depth < 0.2)   # the object 10 cm deep, not the surface
+        ('gaussian', True)
+        """
+        if self.kind != "holograms":
+            return s
+        if glare and s.glare == "off" and self._glare_removable(s):
+            on = s.replace(glare="gaussian")
+            _, notes = self.cleaned(on)
+            if all(n.error is None for n in notes):
+                s = on
+        if depth:
+            from ...analysis.metrics import peak_position
+
+            s = s.replace(depth=float(peak_position(self.sweep(s))[2] - self.surface(s)))
+        return s
+
+    def _glare_removable(self, s: ViewSettings) -> bool:
+        """Whether ``s`` has a ground and every view a known point-like radiator."""
+        from ...imaging.glare._common import Radiator
+
+        if self.medium(s) is None:
+            return False
+        return all(not h.monostatic and isinstance(h.source, Radiator) for h in self.views)
+
     def medium(self, s: ViewSettings) -> Medium | None:
         """The ground of ``s`` at the views' (centre) frequency; None: free space."""
         if s.ground is None or self.kind != "holograms":

@@ -35,12 +35,16 @@ is usually the aperture plane or behind it, where no image can be formed.
 Layout: :mod:`.suppress` (:func:`suppress_surface`, the cut and background
 methods), :mod:`.beams` (the Gaussian-beam fit), :mod:`.image_source` (the
 exact reflected field and the permittivity fit), :mod:`.permittivity`
-(:func:`estimate_permittivity`), ``_common`` (the direct wave, linear fits).
+(:func:`estimate_permittivity`), :mod:`.dominance` (:func:`glare_share`: whether
+an image's brightest point is the glare), ``_common`` (the direct wave, linear
+fits).
 """
 
 # _direct_wave: imported by holoradar.imaging.stream (re-exported, private)
 from ._common import _direct_wave as _direct_wave
+from .dominance import GlareShare, GlareWarning, glare_share
 from .permittivity import estimate_permittivity
 from .suppress import FitWarning, SuppressionReport, suppress_surface
 
-__all__ = ["FitWarning", "SuppressionReport", "estimate_permittivity", "suppress_surface"]
+__all__ = ["FitWarning", "GlareShare", "GlareWarning", "SuppressionReport",
+           "estimate_permittivity", "glare_share", "suppress_surface"]

@@ -1,0 +1,123 @@
+"""Data recorded as I - iQ (the engineering convention exp(+j omega t)) are told from the
+data and said, with the fix; data in holoradar's convention never are."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import holoradar as hr
+from holoradar.app.cli import main
+from holoradar.imaging.iq import DECISIVE_RATIO, IQSignWarning, check_iq_sign, warn_if_conjugated
+
+pytestmark = pytest.mark.filterwarnings("ignore::holoradar.AliasingWarning")
+
+SAND = hr.Medium.half_space(0.30, hr.permittivity(2.5, tan_delta=0.005))
+ONE, BAND = 9.9e9, np.linspace(8e9, 12e9, 11)
+ZS = np.arange(0.30, 0.60, 0.005)
+
+
+def _scene(ground: bool, direct: bool = False) -> hr.Scene:
+    # a horn 5 cm behind the array when its direct wave is in the data (it then focuses
+    # behind the array too), else beside it in the array's plane (the paper's stand)
+    horn = (hr.PointSource((0.0, -0.15, -0.05), pattern_exponent=4, axis=(0.0, 0.15, 0.35))
+            if direct else hr.PointSource((0.0, -0.25, 0.0), pattern_exponent=2))
+    medium = SAND if ground else hr.Medium.free_space()
+    return hr.Scene(medium, horn, [hr.PointTarget((0.02, 0.01, 0.42), 0.05)])
+
+
+CASES = {
+    "free space": dict(ground=False, surface=False, direct=False),
+    "half-space, no glare": dict(ground=True, surface=False, direct=False),
+    "half-space with glare": dict(ground=True, surface=True, direct=False),
+    "glare and the horn's direct wave": dict(ground=True, surface=True, direct=True),
+}
+
+
+def _said(fn, *args, **kw):
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        fn(*args, **kw)
+    return [w for w in said if issubclass(w.category, IQSignWarning)]
+
+
+@pytest.mark.parametrize("frequency", [ONE, BAND], ids=["one frequency", "11 frequencies"])
+@pytest.mark.parametrize("case", list(CASES))
+def test_correct_data_are_never_flagged_and_their_conjugate_always(case, frequency):
+    c = CASES[case]
+    scene = _scene(c["ground"], c["direct"])
+    h = hr.simulate(scene, hr.Aperture.paper(), frequency, include_surface=c["surface"],
+                    include_direct=c["direct"])
+    medium = SAND if c["ground"] else None
+    for z, kw in ((ZS, {"medium": medium}), (None, {})):  # the imaged ranges, or the default
+        assert not _said(warn_if_conjugated, h, z, **kw)
+        said = _said(warn_if_conjugated, hr.conjugate(h), z, **kw)
+        assert len(said) == 1
+        assert "iq_sign=I-iQ" in str(said[0].message)
+        assert check_iq_sign(h, z, **kw).sign == "I+iQ"
+
+
+def test_a_scanned_transceiver_too():
+    ap = hr.Aperture.grid(24, 0.0062, monostatic=True)
+    for f in (ONE, BAND):
+        h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.01, 0.0, 0.2))]), ap, f)
+        assert check_iq_sign(h).sign == "I+iQ"
+        assert check_iq_sign(hr.conjugate(h)).sign == "I-iQ"
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_noise_alone_is_undecided(seed):
+    # Nothing focuses on either side: the peak-to-mean of speckle over N cells is
+    # ln N + 0.58 +- 1.28 on both, and DECISIVE_RATIO = 3 is out of its reach
+    # (probability ~ 0.3 / N^2, see DECISIVE_RATIO).
+    rng = np.random.default_rng(seed)
+    x = hr.Aperture.paper().x
+    h = hr.Hologram(rng.normal(size=(16, 16)) + 1j * rng.normal(size=(16, 16)), x, x, ONE)
+    r = check_iq_sign(h, ZS, medium=SAND)
+    assert r.sign is None and 1 / DECISIVE_RATIO < r.ratio < DECISIVE_RATIO
+
+
+def _device_file(path, h):
+    # a device that writes I and Q with Q negated: I - jQ of the field
+    np.savez(path, I=h.data.real, Q=-h.data.imag, x=h.x * 1000, y=h.y * 1000, f=9.9)
+
+
+def test_load_says_when_a_devices_file_is_i_minus_iq(tmp_path):
+    h = hr.simulate(_scene(True), hr.Aperture.paper(), ONE)
+    _device_file(tmp_path / "scan.npz", h)
+    layout = "i=I,q=Q,units=mm,frequency_unit=GHz"
+    said = _said(hr.load, tmp_path / "scan.npz", layout=layout)
+    assert len(said) == 1 and "scan.npz" in str(said[0].message)
+    # declared, it is read right and nothing is said
+    assert not _said(hr.load, tmp_path / "scan.npz", layout=layout + ",iq_sign=I-iQ")
+    fixed = hr.load(tmp_path / "scan.npz", layout=layout + ",iq_sign=I-iQ")
+    np.testing.assert_allclose(fixed.data, h.data)
+    # the same device writing I + iQ: nothing said
+    np.savez(tmp_path / "ok.npz", I=h.data.real, Q=h.data.imag, x=h.x * 1000, y=h.y * 1000,
+             f=9.9)
+    assert not _said(hr.load, tmp_path / "ok.npz", layout=layout)
+
+
+def test_image_command_warns_once_with_the_fix(tmp_path):
+    h = hr.simulate(_scene(True), hr.Aperture.paper(), ONE)
+    _device_file(tmp_path / "scan.npz", h)
+    hr.save(hr.conjugate(h), tmp_path / "conj.nc")
+    hr.save(h, tmp_path / "ok.nc")
+    ground = ["--eps", "2.5+0.0125j", "--z-surface", "0.30", "--z", "0.30:0.60:0.005"]
+    layout = "i=I,q=Q,units=mm,frequency_unit=GHz"
+    res = CliRunner().invoke(main, ["image", str(tmp_path / "scan.npz"), *ground,
+                                    "--layout", layout, "-o", str(tmp_path / "a.nc")])
+    assert res.exit_code == 0, res.output
+    # one line (load's check and the image's are one warning), naming the layout's fix
+    assert res.output.count("(IQSignWarning)") == 1
+    assert "--layout '...,iq_sign=I-iQ'" in res.output
+    res = CliRunner().invoke(main, ["image", str(tmp_path / "conj.nc"), *ground,
+                                    "-o", str(tmp_path / "b.nc")])
+    assert res.exit_code == 0 and res.output.count("(IQSignWarning)") == 1
+    assert "hr.conjugate" in res.output
+    res = CliRunner().invoke(main, ["image", str(tmp_path / "ok.nc"), *ground,
+                                    "-o", str(tmp_path / "c.nc")])
+    assert res.exit_code == 0 and "IQSignWarning" not in res.output
