@@ -34,6 +34,7 @@ from ..data.hologram import C0, _frequency_axis
 from ..model.scene import Aperture, Scene
 from ..model.simulate import simulate
 from ..model.targets import PlanarTarget
+from ..physics.conductor import PEC_EPS
 from ..physics.green import free_space_green
 from ..physics.medium import Medium
 from ..physics.sources import PointSource
@@ -41,8 +42,6 @@ from ..physics.sources import PointSource
 __all__ = ["KINDS", "PEC_EPS", "reference_field"]
 
 KINDS = ("plate", "empty")
-PEC_EPS = 1e30 + 1e30j
-"""Permittivity standing for a perfect conductor: reflection -1 to 1e-15."""
 
 
 def _image_plate(source: Any, k: float, plate_range: float, pts: np.ndarray) -> np.ndarray:

@@ -65,6 +65,7 @@ import hashlib
 
 import numpy as np
 
+from .conductor import refuse_perfect_conductor, surface_is_perfect_conductor
 from .green import _nodes, _phase_length
 from .medium import Medium
 
@@ -133,6 +134,7 @@ def _profiles(rho: np.ndarray, quad: list[tuple[np.ndarray, np.ndarray, list]],
 
 def _radial_grid(k: float, medium: Medium, rho_max: float) -> np.ndarray:
     """Distances at a sixteenth of the shortest wavelength in the stack, to ``rho_max``."""
+    refuse_perfect_conductor(medium)  # its |n| ~ 1e15 would ask for ~1e17 distances
     n_max = max(abs(medium.n(m)) for m in range(medium.n_regions))
     step = 2 * np.pi / (k * n_max) / 16
     return np.arange(0.0, float(rho_max) + 3 * step, step)
@@ -218,7 +220,9 @@ def reflected_dyadic(k: float, medium: Medium, src: np.ndarray, pts: np.ndarray,
     -------
     ndarray, shape (N, 3, 3)
         ``G[n] @ p`` is the reflected field at ``pts[n]`` (see the module notes
-        for the normalisation).
+        for the normalisation). A perfectly conducting ground
+        (:mod:`holoradar.physics.conductor`) gives the image dipole's field in
+        closed form: the horizontal moment reversed, the vertical one kept.
 
     Examples
     --------
@@ -235,6 +239,11 @@ def reflected_dyadic(k: float, medium: Medium, src: np.ndarray, pts: np.ndarray,
     if src[2] >= z0 or np.any(pts[:, 2] >= z0):
         raise ValueError("reflected_dyadic: the dipole and the points must lie in the air "
                          f"above the surface (range < {z0} m)")
+    if coefficients is None and surface_is_perfect_conductor(medium):
+        # R_h = R_v = -1 at every angle: the Sommerfeld integrals are the mirror image's
+        # field, a dipole whose horizontal moment is reversed and vertical one kept.
+        image = np.array([src[0], src[1], 2 * z0 - src[2]])
+        return free_space_dyadic(k, image, pts) * np.array([-1.0, -1.0, 1.0])
     out = np.empty((len(pts), 3, 3), complex)
     zkeys, inverse = np.unique(np.round(pts[:, 2], 12), return_inverse=True)
     for iz in range(zkeys.size):

@@ -35,6 +35,7 @@ from typing import Literal
 import numpy as np
 
 from .._lazy import lazy_module
+from .conductor import refuse_perfect_conductor, surface_is_perfect_conductor
 from .medium import Medium
 from .propagation import _TransferCache
 
@@ -155,6 +156,10 @@ def green_at_distances(k: float, medium: Medium, z_src: float, z_obs: float,
     on the scale of the ranges, not of the wavelength, so the spline error
     ``(5/384) h^4 max|f^(4)|`` is ~1e-11 (tested against direct evaluation).
 
+    A perfectly conducting ground (:mod:`holoradar.physics.conductor`) reflects
+    ``-exp(i*k*R')/R'``, the mirror image's field, in closed form; the field inside
+    or below a perfect conductor is refused.
+
     Examples
     --------
     >>> m = Medium.half_space(0.3, 4.0)
@@ -167,6 +172,11 @@ def green_at_distances(k: float, medium: Medium, z_src: float, z_obs: float,
     if kind == "reflected":
         z0 = medium.z_interfaces[0]
         air = (z0 - z_src) + (z0 - z_obs)
+        if surface_is_perfect_conductor(medium):
+            # Reflection -1 at every angle: the Sommerfeld integral is the mirror image's
+            # field (the integral's rule and grid would follow |n| ~ 1e15 of PEC_EPS).
+            R = np.hypot(flat, air)
+            return (-np.exp(1j * k * R) / R).reshape(rho.shape)
 
         def field(r: np.ndarray) -> np.ndarray:
             return _reflected(k, medium, r, np.full(r.size, air))
@@ -177,6 +187,7 @@ def green_at_distances(k: float, medium: Medium, z_src: float, z_obs: float,
     if medium.is_free_space or (kind == "transmitted"
                                 and medium.region_of(z_obs) == medium.region_of(z_src)):
         return field(flat).reshape(rho.shape)  # closed form
+    refuse_perfect_conductor(medium)  # before the grid, whose step follows the largest |n|
     step = 2 * np.pi / (k * max(abs(medium.n(m)) for m in range(medium.n_regions))) / 16
     grid = np.arange(flat.min(initial=0.0), flat.max(initial=0.0) + 3 * step, step)
     if flat.size <= 2 * grid.size:
@@ -231,6 +242,7 @@ def _cosine_map(a: float, b: float, n: int, *, at_a: bool,
 def _nodes(k: float, medium: Medium, phase_len: float, rho_max: float,
            air_len: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """Quadrature over kappa: pieces of (kappa, weight*dkappa/dvar)."""
+    refuse_perfect_conductor(medium)  # its |n| would size the rule at ~1e17 nodes
     n_prop = int(_MIN_NODES + _NODES_PER_RADIAN * k * (phase_len + rho_max))
     th, wth = _gauss(0.0, np.pi / 2, n_prop)
     pieces = [(k * np.sin(th), wth * k * np.cos(th))]
