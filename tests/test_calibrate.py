@@ -177,6 +177,33 @@ def test_iq_imbalance_of_the_device_within_its_standard_error(conjugate):
     assert noise.max() < 5 * SIGMA / np.sqrt(NREP)
 
 
+def test_iq_standard_error_holds_when_a_few_groups_hold_most_of_the_power():
+    """The exact correction's leverage (iq.py): one group of ten holding 45% of the power,
+    as the elements nearest the horn do in an empty scene; 1000 trials."""
+    rng = np.random.default_rng(21)
+    trials, m = 1000, 64                                   # 10 groups of m samples
+    share = np.r_[0.45, np.full(9, 0.55 / 9)]
+    amp = np.repeat(np.sqrt(share / m), m)                 # constant amplitude in a group
+    groups = np.repeat(np.arange(10), m)
+    est, var_g, var_p = [], [], []
+    for _ in range(trials):
+        s = amp * np.exp(2j * np.pi * rng.random(amp.size))
+        r = cb.iq_imbalance(s.real, G_IQ * (np.cos(PHI_IQ) * s.imag + np.sin(PHI_IQ) * s.real),
+                            groups)
+        est.append((r.gain, r.phase))
+        var_g.append(r.stderr_gain**2)
+        var_p.append(r.stderr_phase**2)
+    est = np.array(est)
+    for k, v in enumerate((np.array(var_g), np.array(var_p))):
+        # The mean squared standard error estimates the estimate's variance: a sample
+        # variance of T trials has relative sd sqrt(2/(T-1)), the mean of T squared
+        # errors its own sd/sqrt(T) (measured); 5 of their combined sd. The plain sandwich
+        # (n/(n-1) times the sum) gives about half the variance here.
+        ratio = v.mean() / est[:, k].var(ddof=1)
+        tol = 5 * np.sqrt(2 / (trials - 1) + v.var() / (trials * v.mean() ** 2))
+        assert abs(ratio - 1) < tol, (k, ratio, tol)
+
+
 # --- element gains and equalisation ---------------------------------------------------
 @pytest.mark.parametrize("kind", ["plate", "empty"])
 def test_element_gains_from_a_reference_to_the_noise(kind):
@@ -323,6 +350,7 @@ def test_fit_calibration_recovers_every_fault_and_the_field(fitted):
         assert hr.migrate(hr.Hologram(raw.i + 1j * raw.q, X, X, F, source=HORN), zs).peak() != peak
 
 
+@pytest.mark.filterwarnings("ignore::holoradar.calibrate.CalibrationWarning")  # one plate
 def test_fit_calibration_refuses_what_cannot_be_told(fitted):
     refs = fitted["refs"]
     with pytest.raises(ValueError, match="two references"):
@@ -337,6 +365,32 @@ def test_fit_calibration_refuses_what_cannot_be_told(fitted):
     one = cb.RawFrames(refs[0].raw.i[0], refs[0].raw.q[0], X, X, F, DEVICE, source=HORN)
     with pytest.raises(ValueError, match="at least 2 repeats"):
         cb.fit_calibration([cb.Reference(one, "plate", plate_range=PLATES[0]), refs[1]])
+
+
+def test_fit_calibration_warns_when_the_references_leave_the_iq_imbalance_weak(fitted):
+    """A residual image above -40 dB at one standard error is warned of, with the fix."""
+    refs = fitted["refs"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cb.CalibrationWarning)
+        pair = cb.fit_calibration(refs)                     # the plate pair: no warning
+    iq = pair.provenance["iq_imbalance"]
+    se_g, se_p = iq["stderr_gain"][0] / pair.iq_gain[0], iq["stderr_phase_rad"][0]
+    # The residual image of iq_residual to first order: sqrt(dg^2/g^2 + dphi^2)/(2 cos phi).
+    image = 20 * np.log10(np.hypot(se_g, se_p) / (2 * np.cos(pair.iq_phase[0])))
+    assert iq["image_db_at_stderr"][0] == pytest.approx(image, rel=1e-12)
+    assert image < -40
+    # The first-order law itself: the terms dropped are relative O(dg/g, dphi) (|a| = 1 -
+    # dg/(2g) + ..., b's second-order terms), within 4 max(dg/g, dphi) of |b/a|.
+    a, b = cb.iq_residual(1.0, 0.0, 1 + se_g, se_p)
+    assert abs(abs(b / a) / (np.hypot(se_g, se_p) / 2) - 1) < 4 * max(se_g, se_p)
+    # One plate: SE about 3% and 1.8 degrees, -33 dB: warned, naming the fix.
+    with pytest.warns(cb.CalibrationWarning, match=r"(?s)poorly.*-3\d dB.*several ranges.*"
+                                                   r"second reflector"):
+        one = cb.fit_calibration(refs[:1], iq_sign="I-iQ")
+    assert -40 < one.provenance["iq_imbalance"]["image_db_at_stderr"][0] < -30
+    with warnings.catch_warnings():                         # the limit is the caller's
+        warnings.simplefilter("error", cb.CalibrationWarning)
+        cb.fit_calibration(refs[:1], iq_sign="I-iQ", max_iq_image_db=-30)
 
 
 # --- files ----------------------------------------------------------------------------

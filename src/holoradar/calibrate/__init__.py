@@ -34,7 +34,7 @@ from .calibration import Calibration, apply
 from .dc import DCOffset, dc_offset, remove_dc
 from .equalize import equalize_frequencies
 from .faults import DeviceFaults
-from .fit import Reference, fit_calibration
+from .fit import CalibrationWarning, Reference, fit_calibration
 from .gains import element_gains
 from .iq import IQImbalance, correct_iq, iq_imbalance, iq_residual
 from .mask import BadElements, find_bad_elements, interpolate_for_display
@@ -45,6 +45,7 @@ from .sign import IQSign, detect_iq_sign
 __all__ = [
     "BadElements",
     "Calibration",
+    "CalibrationWarning",
     "DCOffset",
     "DeviceFaults",
     "IQImbalance",

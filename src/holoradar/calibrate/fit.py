@@ -14,10 +14,22 @@
 The first reference sets the gains, so it should be the best known one: the
 metal plate at a measured range, whose reflection is the horn's main lobe seen
 in a mirror. See ``docs/calibration.md`` for how each reference is measured.
+
+A weak I/Q estimate is warned of (:class:`CalibrationWarning`): the residual
+image a correction leaves, ``|b/a| = sqrt(dg^2/g^2 + dphi^2)/(2 cos(phi))`` to
+first order (:func:`.iq_residual`), taken at one standard error, above
+``max_iq_image_db`` = -40 dB, i.e. a standard error above about 2% in the gain
+alone or 1.1 degrees in the phase alone. Why -40 dB: the image is a coherent
+ghost of every echo, the surface glare's included, which often stands 20-30 dB
+above a buried target; the other steps reach -50 dB (element gains to 3e-3);
+an uncorrected demodulator's own image is -20 to -30 dB (-20 dB for 15% and 8
+degrees). One plate gives -33 dB, an empty scene and a plate -23 dB, the plate
+at two ranges lambda/8 apart -55 dB (``docs/calibration.md``).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -35,7 +47,11 @@ from .raw import RawFrames
 from .reference import KINDS, reference_field
 from .sign import detect_iq_sign
 
-__all__ = ["Reference", "fit_calibration"]
+__all__ = ["CalibrationWarning", "Reference", "fit_calibration"]
+
+
+class CalibrationWarning(UserWarning):
+    """A calibration step is poorly determined by the measurements given (the fix is named)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,12 +147,50 @@ def _iq_fit(i: np.ndarray, q: np.ndarray, per_frequency: bool) -> list[IQImbalan
     return [iq_imbalance(i[:, f], q[:, f], groups[:, f]) for f in range(i.shape[1])]
 
 
+def iq_image_db(fit: IQImbalance) -> float:
+    """The residual image (dB) a correction leaves at one standard error of ``fit``:
+    ``20 log10(sqrt((SE(g)/g)^2 + SE(phi)^2)/(2 cos(phi)))`` (module text)."""
+    rel = np.hypot(fit.stderr_gain / fit.gain, fit.stderr_phase) / (2 * np.cos(fit.phase))
+    return float(20 * np.log10(rel)) if rel > 0 else -np.inf
+
+
+def plus_minus(value: float, stderr: float) -> str:
+    """``"value +- stderr"``: the error to 2 significant digits, the value to the same place.
+
+    Examples
+    --------
+    >>> plus_minus(1.14637, 0.00361), plus_minus(7.981, 0.158), plus_minus(2.0, 0.0)
+    ('1.1464 +- 0.0036', '7.98 +- 0.16', '2')
+    """
+    if not (np.isfinite(stderr) and stderr > 0):
+        return f"{value:.4g}"
+    places = max(0, 1 - int(np.floor(np.log10(stderr))))
+    return f"{value:.{places}f} +- {stderr:.{places}f}"
+
+
+def _warn_weak_iq(fits: list[IQImbalance], limit_db: float) -> None:
+    images = [iq_image_db(f) for f in fits]
+    worst = int(np.argmax(images))
+    if not images[worst] > limit_db:
+        return
+    f = fits[worst]
+    warnings.warn(
+        f"the references determine the I/Q imbalance poorly: Q gain "
+        f"{plus_minus(f.gain, f.stderr_gain)} ({100 * f.stderr_gain / f.gain:.1f}%), phase "
+        f"{plus_minus(np.degrees(f.phase), np.degrees(f.stderr_phase))} deg, a residual image "
+        f"of {images[worst]:.0f} dB at one standard error (limit {limit_db:g} dB: about 2% "
+        f"or 1.1 deg; {f.effective_groups:.0f} effective elements carry it). Record more "
+        "reference scenes whose phases differ: the plate at several ranges (two an eighth "
+        "of a wavelength apart cancel most of the error) or a second reflector; or estimate "
+        "it from a survey's frames (iq_samples=)", CalibrationWarning, stacklevel=3)
+
+
 def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None = None,
                     iq_samples: RawFrames | None = None,
                     iq_sign: Literal["I+iQ", "I-iQ"] | None = None,
                     iq_per_frequency: bool = False, dead_below: float = 0.1,
                     noisy_above: float = 3.0, min_sign_margin_db: float = 10.0,
-                    notes: str = "") -> Calibration:
+                    max_iq_image_db: float = -40.0, notes: str = "") -> Calibration:
     """Run the calibration steps in order (module text) and return the Calibration.
 
     Parameters
@@ -160,6 +214,9 @@ def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None =
         Thresholds of :func:`.find_bad_elements`.
     min_sign_margin_db : float
         Refuse a detected sign whose margin is smaller (dB).
+    max_iq_image_db : float
+        Warn (:class:`CalibrationWarning`) when the I/Q correction's residual image
+        at one standard error exceeds this (dB; module text).
     notes : str
         Free text kept in the provenance.
 
@@ -172,6 +229,11 @@ def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None =
     ValueError
         Frames of different devices, arrays or frequencies; too few references or
         repeats; an unclear sign.
+
+    Warns
+    -----
+    CalibrationWarning
+        The I/Q imbalance is poorly determined (``max_iq_image_db``).
 
     Examples
     --------
@@ -223,6 +285,7 @@ def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None =
         iq_from = "references"
         fits = _iq_fit(np.stack([m[0] for m in means]), np.stack([m[1] for m in means]),
                        iq_per_frequency)
+    _warn_weak_iq(fits, max_iq_image_db)
     g = np.array([f.gain for f in fits])[:, None, None]
     phi = np.array([f.phase for f in fits])[:, None, None]
     z = [correct_iq(i, q, g, phi) for i, q in means]
@@ -256,7 +319,9 @@ def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None =
         "iq_imbalance": {"from": iq_from, "per_frequency": bool(iq_per_frequency),
                          "n_samples": [f.n_samples for f in fits],
                          "stderr_gain": [f.stderr_gain for f in fits],
-                         "stderr_phase_rad": [f.stderr_phase for f in fits]},
+                         "stderr_phase_rad": [f.stderr_phase for f in fits],
+                         "effective_groups": [f.effective_groups for f in fits],
+                         "image_db_at_stderr": [iq_image_db(f) for f in fits]},
         "iq_sign": {"how": how, "margin_db": margin},
         "dead_below": float(dead_below), "noisy_above": float(noisy_above),
         "dead": int(bad.dead.sum()), "noisy": int(bad.noisy.sum()),
