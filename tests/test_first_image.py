@@ -4,6 +4,7 @@ point it is said, with the fix, and the viewer opens on the object with the glar
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -127,3 +128,32 @@ def test_viewer_keeps_what_was_asked_and_what_cannot_be_done(views, tmp_path):
     look = plane.opening_settings(plane.default_settings(ground={"surface": 0.30, "eps": 2.5}),
                                   depth=False)
     assert look.glare == "off"
+
+
+def test_the_demos_next_commands_show_the_letter_and_the_readme_runs_them(tmp_path,
+                                                                           monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    run = CliRunner().invoke
+    res = run(main, ["demo", "--out", "my_demo", "--upsample", "1"])
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    i = next(k for k, t in enumerate(lines) if t.strip().startswith("next:"))
+    steps = [lines[i].split("next:", 1)[1].split(), lines[i + 1].split()]
+    assert [s[:2] for s in steps] == [["holoradar", "suppress"], ["holoradar", "image"]]
+    # the README's sequence after the demo is the one the demo prints
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    shown = [t[2:].split() for t in readme.splitlines()
+             if t.startswith(("$ holoradar suppress my_demo", "$ holoradar image clean.nc"))]
+    assert shown == steps
+    for s in steps:
+        res = run(main, s[1:])
+        assert res.exit_code == 0, res.output
+        assert "GlareWarning" not in res.output and "IQSignWarning" not in res.output
+    # the letter R (a 10 x 15 cm box at the origin, 42 cm away), within one lateral
+    # resolution cell lambda*L/A of it and half the one-frequency depth resolution
+    # (21 cm FWHM in the sand) of its range
+    st = lab_stand()
+    x, y, z = hr.load("img.nc").peak()
+    cell = hr.C0 / st.frequency * st.scene.medium.apparent_distance(st.z_object) / 0.40
+    assert abs(x) <= 0.05 + cell and abs(y) <= 0.075 + cell
+    assert abs(z - st.z_object) <= 0.21 / 2

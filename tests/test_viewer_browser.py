@@ -123,8 +123,9 @@ def browser():
 def rod_page(rod, browser, tmp_path_factory):
     path, _, _ = rod
     out = tmp_path_factory.mktemp("exports")
+    # the raw hologram first (the viewer would open with the glare removed)
     with _page(browser, [path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
-                         "--depth", "0.05", "--export-dir", out]) as server:
+                         "--depth", "0.05", "--glare", "off", "--export-dir", out]) as server:
         yield browser, server, out
 
 

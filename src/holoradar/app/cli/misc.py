@@ -25,7 +25,8 @@ def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
     """Simulate the paper's lab stand (letter R in sand) and image it.
 
     Writes figures, summary.json and the simulated hologram (hologram.nc) to
-    OUT, so that `holoradar image OUT/hologram.nc ...` can be tried next.
+    OUT, so that `holoradar suppress OUT/hologram.nc ...` (its glare) and
+    `holoradar image ...` can be tried next.
     """
     from ..demo import run_demo
 
@@ -51,8 +52,11 @@ def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
         f"  array pitch exceeds lambda/2: waves beyond {th['max_unaliased_angle_deg']:.0f} "
         "degrees off axis alias",
         f"  wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s",
-        f"  next: holoradar image {out}/hologram.nc --z 0.30:0.60:0.005 --eps 2.5+0.0125j "
-        "--z-surface 0.30 --out img.nc",
+        # the glare first (the hologram holds no direct wave), else the image is the glare
+        f"  next: holoradar suppress {out}/hologram.nc --eps 2.5+0.0125j --z-surface 0.30 "
+        "--method image_source --no-direct -o clean.nc",
+        "        holoradar image clean.nc --z 0.30:0.60:0.005 --eps 2.5+0.0125j "
+        "--z-surface 0.30 -o img.nc",
     ])
 
 
