@@ -78,6 +78,12 @@ def test_noise_alone_is_undecided(seed):
     h = hr.Hologram(rng.normal(size=(16, 16)) + 1j * rng.normal(size=(16, 16)), x, x, ONE)
     r = check_iq_sign(h, ZS, medium=SAND)
     assert r.sign is None and 1 / DECISIVE_RATIO < r.ratio < DECISIVE_RATIO
+    # nothing at all, or numbers near the float limit (a damaged file): no verdict, no
+    # overflow
+    assert check_iq_sign(h.with_data(np.zeros((16, 16)))).sign is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert check_iq_sign(h.with_data(h.data * 1e300), ZS, medium=SAND).sign is None
 
 
 def _device_file(path, h):
@@ -121,3 +127,13 @@ def test_image_command_warns_once_with_the_fix(tmp_path):
     res = CliRunner().invoke(main, ["image", str(tmp_path / "ok.nc"), *ground,
                                     "-o", str(tmp_path / "c.nc")])
     assert res.exit_code == 0 and "IQSignWarning" not in res.output
+
+
+def test_a_large_array_with_many_frames_is_judged_on_a_part_of_it():
+    # 300 x 300 elements and 10 frames: the check looks at the central 128 x 128 and 4
+    # frames (a few FFTs of 256 x 256), and the centre still focuses the point in front
+    ap = hr.Aperture.grid(300, 0.005)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.05, 0.0, 0.3))]), ap, ONE)
+    h = h.with_data(np.stack([h.data] * 10))
+    assert check_iq_sign(h).sign == "I+iQ"
+    assert check_iq_sign(hr.conjugate(h)).sign == "I-iQ"

@@ -53,6 +53,14 @@ MAX_FREQUENCIES = 4
 """Frequencies the check images (spread over the band); each is imaged alone and the
 intensities add, so a device's phase response across the band does not matter."""
 
+MAX_ELEMENTS = 128
+"""Elements along each axis the check looks at (the central ones): a larger array's
+centre still focuses what lies in front of it, and the check stays a few FFTs of at
+most 256 x 256 whatever the array."""
+
+MAX_FRAMES = 4
+"""Frames (views, repeats) the check looks at, spread over those the data hold."""
+
 
 class IQSignWarning(UserWarning):
     """The data focus behind the array: recorded as ``I - iQ`` (their complex conjugate)."""
@@ -90,6 +98,21 @@ def _spread(values: np.ndarray, n: int) -> np.ndarray:
     if values.size <= n:
         return values
     return values[np.unique(np.round(np.linspace(0, values.size - 1, n)).astype(int))]
+
+
+def _reduced(hologram: Hologram) -> Hologram:
+    """One frequency's data cut to what the check needs: at most :data:`MAX_FRAMES` frames
+    and the central :data:`MAX_ELEMENTS` x :data:`MAX_ELEMENTS` elements."""
+    ny, nx = hologram.data.shape[-2:]
+    data = hologram.data.reshape((-1, ny, nx))
+    data = data[_spread(np.arange(data.shape[0]), MAX_FRAMES)]
+    y0, x0 = max(0, (ny - MAX_ELEMENTS) // 2), max(0, (nx - MAX_ELEMENTS) // 2)
+    y1, x1 = min(ny, y0 + MAX_ELEMENTS), min(nx, x0 + MAX_ELEMENTS)
+    data = data[:, y0:y1, x0:x1]
+    # a scale changes no sharpness, and unit data cannot overflow an intensity
+    peak = float(np.max(np.abs(data))) if data.size else 0.0
+    return hologram.replace(data=data / peak if peak > 0 else data, x=hologram.x[x0:x1],
+                            y=hologram.y[y0:y1])
 
 
 def _without_direct_wave(hologram: Hologram) -> Hologram:
@@ -132,8 +155,9 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
     Back-propagates the data and their conjugate (the field of the mirror scene
     behind the aperture) to the same ranges and compares the sharpness of their
     foci; decides only when one is :data:`DECISIVE_RATIO` times sharper. Cheap:
-    at most :data:`MAX_PLANES` planes and :data:`MAX_FREQUENCIES` frequencies, one
-    pixel per element.
+    at most :data:`MAX_PLANES` planes, :data:`MAX_FREQUENCIES` frequencies,
+    :data:`MAX_FRAMES` frames and the central :data:`MAX_ELEMENTS` x
+    :data:`MAX_ELEMENTS` elements, one pixel per element.
 
     Parameters
     ----------
@@ -166,7 +190,7 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
         # beside the array, and it focuses in front as any scatterer does. A level
         # ground frame images the footprint only.
         opts["fov"] = "aperture" if opts.get("frame") == "ground" else "full"
-        views = [_without_direct_wave(hologram.at_frequency(int(i)))
+        views = [_without_direct_wave(_reduced(hologram.at_frequency(int(i))))
                  for i in _spread(np.arange(hologram.nf), MAX_FREQUENCIES)]
         sides = []
         for flip in (False, True):
@@ -181,7 +205,9 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
             sides.append(_sharpness(np.sqrt(total)))
     except ValueError:  # a grid or geometry the imaging refuses: no verdict
         return IQSignCheck(None, float("nan"), ())
-    ratio = sides[0] / max(sides[1], 1e-300)
+    if not (sides[0] > 0 and sides[1] > 0):  # data all zero: nothing to compare
+        return IQSignCheck(None, float("nan"), tuple(float(v) for v in zs))
+    ratio = sides[0] / sides[1]
     sign: Literal["I+iQ", "I-iQ"] | None = None
     if ratio >= DECISIVE_RATIO:
         sign = "I+iQ"
