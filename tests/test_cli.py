@@ -126,3 +126,33 @@ def test_image_command_reads_and_writes_netcdf_and_never_destroys_data(tmp_path)
     assert res.exit_code == 2 and ".nc or .nc4 or .npz" in res.output
     assert src.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["holo.nc", "img.nc", "img.png"]
+
+
+def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch):
+    """The third panel's title ran off the figure ('... to L = 37.6 c'); the glare figure
+    wrote z_m = 2 z0 - z_s without saying what z0 and z_s are."""
+    from holoradar.app import demo, plotting
+
+    figs = []
+    real = plotting.to_png
+
+    def keep(fig, *args, **kwargs):
+        figs.append(fig)
+        return real(fig, *args, **kwargs)
+
+    monkeypatch.setattr(plotting, "to_png", keep)
+    demo.run_demo(None, upsample=1)
+    assert len(figs) == 5
+    for fig in figs:
+        renderer = fig.canvas.get_renderer()
+        for ax in fig.axes:
+            if not ax.get_title():
+                continue
+            box = ax.title.get_window_extent(renderer)
+            # inside the figure, and clear of every other axes (a colorbar drew over it)
+            assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1, ax.get_title()
+            for other in fig.axes:
+                if other is not ax:
+                    assert not box.overlaps(other.get_window_extent(renderer)), ax.get_title()
+    glare = next(f.get_suptitle() for f in figs if "mirror image" in f.get_suptitle())
+    assert "2 z0 - z_s" in glare and "surface z0 = 30 cm" in glare and "horn z_s = 0 cm" in glare

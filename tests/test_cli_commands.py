@@ -76,8 +76,13 @@ def test_every_command_has_help_and_json(holo_nc, tmp_path):
     assert json.loads(res.stdout)["out"] == str(tmp_path / "i.nc")
     res = run("plot", tmp_path / "i.nc", "-o", tmp_path / "p.png", "--json")
     assert json.loads(res.stdout)["kind"] == "Image"
+    # -q hides progress and narrative, never the result (warnings still go to stderr)
     res = run("image", holo_nc, "--z", "0.42", "-o", tmp_path / "q.nc", "--quiet")
-    assert res.stdout == ""  # warnings still go to stderr
+    assert res.stdout == f"wrote {tmp_path / 'q.nc'}\nwrote {tmp_path / 'q.png'}\n"
+    res = run("simulate", SCENE, "-o", tmp_path / "q2.nc", "-q")
+    assert res.stdout == f"wrote {tmp_path / 'q2.nc'}\n"
+    res = run("theory", "-q")  # every line of theory is its answer
+    assert res.stdout.count("\n") == 5 and "lateral resolution" in res.stdout
 
 
 def test_scene_file_simulates_and_images_through_layers_and_loss(holo_nc, tmp_path):
@@ -119,6 +124,14 @@ def test_scene_file_errors_name_the_key(tmp_path):
                                                                   "integer"),
         ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[ground]\nsurface = 0.3\n"
          "eps = -4\n", "negative real part"),
+        # judged as given: with a loss tangent it said "Im(eps) >= 0 ... (-2.5-0.0125j)"
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\n[ground]\nsurface = 0.3\n"
+         "eps = -2.5\ntan_delta = 0.005\n", "bad.ground.eps = -2.5 has a negative real part"),
+        # ranges in centimetres: 42 m and 30 m in front of a 40 cm array focus nothing
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.025\n[[target]]\n"
+         "position = [0, 0, 42]\n", "bad.target[0].position at range 42 m in front of a 0.4 m"),
+        ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.025\n[ground]\nsurface = 30\n"
+         "eps = 2.5\n", "bad.ground.surface at range 30 m"),
         ("frequency = 9.9e9\n[aperture]\nn = 16\npitch = 0.02\ncolour = 1\n",
          "unknown key(s) ['colour']"),
         ("frequency = 9.9e9\n[[target]]\nposition = [0, 0]\n", "missing table [aperture]"),
@@ -332,6 +345,22 @@ def test_batch_and_mosaic_from_the_command_line(tmp_path):
     # The stone at x = 0.12 m: within one map pixel (pitch / upsample = 5 mm).
     assert abs(peak[0] - 0.12) <= 0.005 and abs(peak[1]) <= 0.005
     run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.png", "-q")
+    # A depth outside the stored planes took the nearest plane without a word.
+    one_line_error(run("mosaic", store, "--depth", "30", "-o", tmp_path / "m30.png", ok=False),
+                   "--depth", "30 m is outside the stored planes 0.3 m", "centimetres",
+                   "--depth 0.3")
+    one_line_error(run("mosaic", store, "--depth", "0.80", "-o", tmp_path / "m80.png",
+                       ok=False), "0.8 m is outside the stored planes 0.3 m")
+    res = run("mosaic", store, "--depth", "0.3", "--z-surface", "0.4", "-o",
+              tmp_path / "m40.png", "-q")
+    assert "warning: --z-surface 0.4 m lies beyond the mapped plane" in res.output
+    # Ranges against the frames' array (12 x 1 cm at 9.9 GHz: nothing focuses beyond 0.48 m),
+    # before any frame is imaged.
+    one_line_error(run("batch", pattern, "-o", tmp_path / "cm.zarr", "--z", "30",
+                       "--scheduler", "synchronous", ok=False), "--z", "centimetres",
+                   "--z 0.3")
+    assert not (tmp_path / "cm.zarr").exists()
+    assert not list(tmp_path.glob("m[38]0.png"))
 
 
 def test_calibrate_apply_reads_the_device_the_file_records(tmp_path):
@@ -375,6 +404,10 @@ def test_autofocus_from_the_command_line_equals_the_library(tmp_path):
                        "3", ok=False), "--eps-range")
     one_line_error(run("autofocus", tmp_path / "h.nc", "--layers", "0.3:3,0.4:5", ok=False),
                    "half-space")
+    # Depths in centimetres: refused before the search, with the metres meant.
+    one_line_error(run("autofocus", tmp_path / "h.nc", "--z-surface", "0.30", "--depth-range",
+                       "2,20", ok=False), "--depth-range", "centimetres",
+                   "--depth-range 0.02,0.2")
     # Noise only: "not determinable" is an answer (exit 0), with the reason.
     noise = np.random.default_rng(0).standard_normal((*h.shape, 2)) @ [1, 1j]
     hr.save(hr.Hologram(noise, h.x, h.y, F), tmp_path / "n.nc")
@@ -382,3 +415,94 @@ def test_autofocus_from_the_command_line_equals_the_library(tmp_path):
               tmp_path / "n.png")
     assert "not determinable" in res.stdout and "noise" in res.stdout
     assert "no plot" in res.stdout and not (tmp_path / "n.png").exists()
+    # -q printed nothing, not even the answer: now the answer alone.
+    res = run("autofocus", tmp_path / "n.nc", "--z-surface", "0.30", "-q")
+    assert res.stdout.splitlines() == [res.stdout.splitlines()[0]]
+    assert res.stdout.startswith("eps' not determinable")
+
+
+def test_unit_slips_in_options_are_refused_before_any_work(holo_nc, tmp_path, monkeypatch):
+    """Centimetres typed for metres ran a minute and imaged 35 m away with exit code 0, or
+    imaged in air with the ground ignored: now refused like a file's unit slip, naming the
+    option and the metres meant; planes above a plausible ground are imaged with a warning."""
+    out = tmp_path / "a.nc"
+    one_line_error(run("image", holo_nc, "--z", "35:55:0.5", "--eps", "2.5", "--z-surface", "30",
+                       "-o", out, ok=False),
+                   "--z", "35..55 m in front of a 0.4 m array", "centimetres",
+                   "--z 0.35:0.55:0.005")
+    one_line_error(run("image", holo_nc, "--z", "0.42", "--eps", "2.5", "--z-surface", "30",
+                       "-o", out, ok=False), "--z-surface", "centimetres", "--z-surface 0.3")
+    one_line_error(run("image", holo_nc, "--z", "42", "-o", out, ok=False), "--z 0.42")
+    one_line_error(run("image", holo_nc, "--z", "0.42", "--layers", "0.30:2.5,40:3", "-o", out,
+                       ok=False), "--layers", "a layer top at 40 m", "centimetres")
+    one_line_error(run("synthesize", holo_nc, "--z", "42", "-o", out, ok=False), "--z 0.42")
+    one_line_error(run("suppress", holo_nc, "--eps", "2.5", "--z-surface", "30", "-o", out,
+                       ok=False), "--z-surface 0.3")
+    one_line_error(run("plan-oblique", "--target", "0,5,42", ok=False), "--target 0,0.05,0.42")
+    one_line_error(run("plan-oblique", "--z-surface", "30", ok=False), "--z-surface 0.3")
+    assert not list(tmp_path.iterdir())  # nothing written by a refusal
+    # Every plane in the air above a plausible ground can be meant: imaged, with a warning.
+    res = run("image", holo_nc, "--z", "0.10:0.25:0.05", "--eps", "2.5", "--z-surface", "0.3",
+              "-o", out)
+    assert ("warning: every plane of --z (0.1..0.25 m) lies above the ground surface at "
+            "0.3 m") in res.output
+    # --no-check takes a range as given.
+    run("image", holo_nc, "--z", "42", "-o", tmp_path / "far.nc", "--no-png", "--no-check")
+    # plot labels depths with --z-surface: 30 for 30 cm is refused, beyond the planes warned
+    one_line_error(run("plot", out, "-o", tmp_path / "p.png", "--z-surface", "30", ok=False),
+                   "--z-surface 0.3")
+    res = run("plot", out, "-o", tmp_path / "p.png", "--z-surface", "0.3")
+    assert "warning: --z-surface 0.3 m lies beyond every plane" in res.output
+    # view --depth: outside an image's planes, or beyond what the array can focus; refused
+    # before the page is served.
+    from holoradar.app.cli import view as view_cli
+
+    def serve(*args, **kwargs):
+        raise RuntimeError("served")
+
+    monkeypatch.setattr(view_cli, "_serve", serve)
+    one_line_error(run("view", out, "--depth", "15", "--no-browser", ok=False),
+                   "--depth", "outside the image's planes 0.1..0.25 m", "--depth 0.15")
+    one_line_error(run("view", holo_nc, "--eps", "2.5", "--z-surface", "0.3", "--depth", "12",
+                       "--no-browser", ok=False),
+                   "--depth", "a depth 12 m below the surface at 0.3 m", "--depth 0.12")
+
+
+def test_a_permittivity_slip_reads_the_same_wherever_it_is_made(holo_nc, tmp_path):
+    """eps = -2.5 in a scene file said 'Im(eps) >= 0 ... (-2.5-0.0125j)' (the loss tangent
+    applied first), --eps -2.5 'negative real part': one check, one sentence."""
+    sentence = "-2.5 has a negative real part: a sign slip?"
+    scene = SCENE.read_text().replace("eps = 2.5", "eps = -2.5")
+    (tmp_path / "neg.toml").write_text(scene)
+    res = run("simulate", tmp_path / "neg.toml", "-o", tmp_path / "h.nc", ok=False)
+    one_line_error(res, "neg.ground.eps = " + sentence)
+    for ground, name in [(["--eps", "-2.5", "--tan-delta", "0.005", "--z-surface", "0.3"],
+                          "--eps"),
+                         (["--eps", "-2.5", "--z-surface", "0.3"], "--eps"),
+                         (["--layers", "0.3:2.5,0.4:-2.5"], "--layers")]:
+        res = run("image", holo_nc, "--z", "0.42", *ground, "-o", tmp_path / "i.nc", ok=False)
+        one_line_error(res, f"Invalid value for {name}", sentence)
+    with pytest.raises(ValueError, match="eps = " + sentence.replace("?", r"\?")):
+        hr.Medium.half_space(0.3, -2.5)
+    assert not (tmp_path / "h.nc").exists() and not (tmp_path / "i.nc").exists()
+
+
+def test_info_shows_each_steps_parameters_and_refusals_name_force(holo_nc, tmp_path):
+    """info showed step names only (parameters with --json alone); an existing output was
+    refused with the API's 'overwrite=True'."""
+    out = tmp_path / "i.nc"
+    run("image", holo_nc, "--z", "0.40:0.44:0.02", "--eps", "2.5", "--z-surface", "0.3", "-o",
+        out, "-q")
+    text = run("info", out).output
+    assert "input=sand_box.toml, scene=<" in text  # the scene's text is long: --json has it
+    assert "input=holo.nc, z=0.40:0.44:0.02, method=angular, frame=aperture" in text
+    assert "(--json shows every parameter whole)" in text
+    for res in (run("image", holo_nc, "--z", "0.42", "-o", out, ok=False),):
+        one_line_error(res, "--out", "exists: pass --force to replace it")
+        assert "overwrite=True" not in res.output
+    out.unlink()  # the PNG beside it is left: refused by its own name
+    res = run("image", holo_nc, "--z", "0.42", "-o", out, ok=False)
+    one_line_error(res, "--out's PNG", "exists: pass --force to replace it")
+    assert "overwrite=True" not in res.output
+    with pytest.raises(ValueError, match=r"exists: pass overwrite=True to replace it"):
+        hr.save(hr.load(holo_nc), holo_nc)  # the API keeps the API's word

@@ -222,7 +222,11 @@ def test_unit_mistakes_are_caught_before_imaging(tmp_path):
 
 
 @pytest.mark.parametrize("eps, cause", [(-2.5 + 0.01j, "negative real part"),
-                                        (0.005, "below 1"), (0.5 + 0.1j, "below 1")])
+                                        (0.005, "below 1"), (0.5 + 0.1j, "below 1"),
+                                        # a sign slip with its loss: the sign is the cause
+                                        (-2.5 - 0.0125j, "-2.5-0.0125j has a negative real"),
+                                        (2.5 - 0.0125j, "negative imaginary part, a medium "
+                                                        "with gain")])
 def test_implausible_permittivity_names_the_likely_mistake(eps, cause):
     with pytest.raises(ValueError, match=cause):
         hr.Medium.half_space(0.3, eps)
@@ -451,6 +455,25 @@ def test_layout_edge_cases(tmp_path):
         hr.load(tmp_path / "yxf.npz")
     np.savez(tmp_path / "one.npz", data=FIELD[None], x=X, y=Y, frequency=np.array([F]))
     assert hr.load(tmp_path / "one.npz").data.shape == (6, 8)
+
+
+def test_a_sidecar_coordinate_in_another_form_is_refused(tmp_path):
+    """x given as an object in a sidecar was skipped without a word: refused by name."""
+    np.save(tmp_path / "s.npy", FIELD)
+    (tmp_path / "s.json").write_text(json.dumps({"x": {"start": -0.0875, "step": 0.025, "n": 8},
+                                                 "y": Y.tolist(), "frequency": F}))
+    with pytest.raises(ValueError, match=r"^sidecar s.json: 'x' must be a number or a list of "
+                                         r"numbers .* got an object \{\"start\""):
+        hr.load(tmp_path / "s.npy")
+    # the same for a variable the sidecar's layout names as a coordinate
+    (tmp_path / "s.json").write_text(json.dumps({"layout": {"y": "rows"}, "x": X.tolist(),
+                                                 "rows": "0, 0.025, 0.05", "frequency": F}))
+    with pytest.raises(ValueError, match=r"'rows' must be a number or a list of numbers"):
+        hr.load(tmp_path / "s.npy")
+    # metadata that is no coordinate may take any form
+    (tmp_path / "s.json").write_text(json.dumps({"x": X.tolist(), "y": Y.tolist(),
+                                                 "frequency": F, "device": {"id": "HSR-7"}}))
+    _same(hr.load(tmp_path / "s.npy"))
 
 
 _json = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-10**9, 10**9),

@@ -87,7 +87,8 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
         at_obj_clean = migrate(clean, z_obj, medium=medium, upsample=upsample)
         no_medium = migrate(clean, L, upsample=upsample)
         # The glare is the wave of the horn's mirror image: it travels in air only, so
-        # it focuses under free-space migration at z_m = 2*z0 - z_s, beside the array.
+        # it focuses under free-space migration at z_m = 2*z0 - z_s (z0 the surface's
+        # range, z_s the horn's), beside the array.
         z_m = 2 * stand.z_surface - scene.source.position[2]
         mirror_plane = migrate(holo, z_m, upsample=upsample, fov="full")
     t_img = time.perf_counter() - t1
@@ -147,7 +148,7 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
         "image_object_range.png": plotting.plot_image(
             [at_obj, at_obj_clean, no_medium],
             ["with surface glare (migrated through sand)", "targets only (through sand)",
-             f"targets only, free-space migration to L = {L * 100:.1f} cm"],
+             "targets only (free space, apparent range L)"],
             outline=outline, suptitle="Image at the object (white: true letter R)"),
         "depth_sweep.png": plotting.plot_depth_sweep(
             sweep_clean, y=0.0, marks={"true range": z_obj, "surface": stand.z_surface},
@@ -156,12 +157,14 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
             [mirror_plane], ["free-space migration of the full hologram"],
             marks={"horn's mirror image": scene.source.mirror_position(medium)[:2],
                    "array": None}, aperture=(ap.x, ap.y),
-            suptitle=f"Surface glare: the horn's mirror image\nfocuses at z_m = 2 z0 - z_s = "
-                     f"{z_m * 100:.0f} cm, beside the array"),
+            suptitle=f"Surface glare: the horn's mirror image focuses beside the array\n"
+                     f"at z_m = 2 z0 - z_s = {z_m * 100:.0f} cm (surface z0 = "
+                     f"{stand.z_surface * 100:.0f} cm, horn z_s = "
+                     f"{scene.source.position[2] * 100:.0f} cm)"),
         "spectrum_window.png": plotting.plot_spectrum(
             p[keep], p[keep], spec[np.ix_(keep, keep)], [win],
             nyquist=np.pi / float(ap.x[1] - ap.x[0]),
-            title="Letter R spectrum |F(p, q)| and the window of the 16 x 16 array"),
+            title="Letter R spectrum |F(p, q)|, 16 x 16 array's window"),
     }
     pngs = {name: plotting.to_png(fig) for name, fig in figs.items()}
     if out is not None:

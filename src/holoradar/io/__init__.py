@@ -221,17 +221,31 @@ def read_sidecar(path: Path) -> tuple[dict[str, np.ndarray], Layout | None]:
     if not isinstance(doc, dict):
         raise ValueError(f"sidecar {path.name} must hold a JSON object, got "
                          f"{type(doc).__name__}")
+    lay = doc.get("layout")
+    # The grid's own entries must be numbers: skipping an x given as {"start": ...}
+    # would image on a made-up grid, or fail later naming the wrong cause.
+    grid = {"x", "y", "frequency"} | ({v for k in ("x", "y", "frequency")
+                                       if isinstance(v := lay.get(k), str)}
+                                      if isinstance(lay, dict) else set())
     extra: dict[str, np.ndarray] = {}
     for key, value in doc.items():
-        if key == "layout" or isinstance(value, bool):
+        if key == "layout":
             continue
-        try:
-            arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError, OverflowError, RecursionError):
-            continue
-        if arr.ndim <= 2:
+        arr = None
+        if not isinstance(value, bool):
+            try:
+                arr = np.asarray(value, dtype=float)
+            except (TypeError, ValueError, OverflowError, RecursionError):
+                arr = None
+        if arr is not None and arr.ndim <= 2:
             extra[key] = arr
-    lay = doc.get("layout")
+        elif key in grid:
+            shown = json.dumps(value)
+            kind = {dict: "an object", list: "a list", str: "a string", bool: "a boolean"}.get(
+                type(value), type(value).__name__)
+            raise ValueError(f"sidecar {path.name}: {key!r} must be a number or a list of "
+                             f"numbers (e.g. \"{key}\": [-0.1875, -0.1625, ...]), got {kind} "
+                             f"{shown if len(shown) <= 60 else shown[:57] + '...'}")
     return extra, (None if lay is None else Layout.from_mapping(lay, f"sidecar {path.name} "
                                                                      "layout"))
 

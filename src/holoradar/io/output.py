@@ -36,7 +36,10 @@ def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
                  name: str = "path", folder: bool = False) -> Path:
     """Validate an output path before any computation; return it as a ``Path``.
 
-    ``folder=True`` for an output that is itself a folder (a Zarr store).
+    ``folder=True`` for an output that is itself a folder (a Zarr store). A
+    ``name`` that is a command-line option (``--out``, ``--out's PNG``) gets the
+    command line's word in a refusal (``--force``); any other the API's
+    (``overwrite=True``).
 
     Raises
     ------
@@ -76,8 +79,8 @@ def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
     if target.is_dir() and not folder:
         raise ValueError(f"{name} {str(target)!r} is a folder")
     if target.exists() and not overwrite:
-        raise ValueError(f"{name} {str(target)!r} exists: pass overwrite=True (--force on the "
-                         "command line) to replace it")
+        how = "--force" if name.startswith("--") else "overwrite=True"
+        raise ValueError(f"{name} {str(target)!r} exists: pass {how} to replace it")
     return target
 
 

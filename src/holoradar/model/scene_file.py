@@ -78,7 +78,7 @@ import numpy as np
 from ..data.hologram import C0
 from ..data.pose import Pose
 from ..physics.dipole import Dipole
-from ..physics.medium import Medium, permittivity
+from ..physics.medium import Medium, check_ground_permittivity, permittivity
 from ..physics.sources import GaussianBeam, PlaneWave, PointSource
 from . import shapes
 from .scene import Aperture, Scene
@@ -232,6 +232,9 @@ def _eps(m: Mapping[str, Any], where: str, frequency: float) -> complex:
     if eps is None:
         raise ValueError(f"{where}: missing key 'eps' (relative permittivity, e.g. 2.5 or "
                          "'2.5+0.0125j')")
+    # Judged as given, before the loss is added: -2.5 with tan_delta 0.005 is a sign
+    # slip, not "a medium with gain" (-2.5-0.0125j), and is named as one.
+    check_ground_permittivity(eps, f"{where}.eps")
     tan_delta = _number(m, "tan_delta", where, 0.0, minimum=0.0)
     sigma = _number(m, "sigma", where, None, minimum=0.0, unit="S/m")
     if (tan_delta or sigma) and eps.imag:
@@ -410,6 +413,35 @@ def _plausible_pitch(aperture: Aperture, f_max: float, where: str) -> None:
                              "pitch in metres is expected")
 
 
+def _plausible_ranges(aperture: Aperture, medium: Medium, targets: list[Any], f_max: float,
+                      where: str) -> None:
+    """The ranges the command line checks: no target or interface where an array of
+    this width focuses nothing (a range in centimetres or millimetres read as metres)."""
+    from ..data.plausibility import range_problem
+
+    width = max(aperture.x.size * abs(float(aperture.x[1] - aperture.x[0])),
+                aperture.y.size * abs(float(aperture.y[1] - aperture.y[0])))
+    height = float(aperture.pose.center[2])  # ranges are from the array, not the world's 0
+    ranges: list[tuple[str, float]] = []
+    if not medium.is_free_space:
+        key = "ground.surface" if medium.n_regions == 2 else \
+            f"ground.layer[{medium.n_regions - 2}].top"
+        ranges.append((key, float(medium.z_interfaces[-1])))
+    for i, t in enumerate(targets):
+        if isinstance(t, PointTarget):
+            ranges.append((f"target[{i}].position", float(t.position[2])))
+        elif isinstance(t, LineTarget):
+            ranges.append((f"target[{i}].start/end", float(max(t.start[2], t.end[2]))))
+        elif isinstance(t, PlanarTarget):
+            ranges.append((f"target[{i}].z", float(t.z)))
+    for key, z in ranges:
+        problem = range_problem(z - height, width, f_max,
+                                None if medium.is_free_space else medium,
+                                f"{where}.{key} at range {z:.4g} m")
+        if problem is not None:
+            raise ValueError(problem)
+
+
 def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpec:
     """A :class:`SceneSpec` from a parsed TOML document (see the module's example)."""
     _unknown(doc, {"frequency", "aperture", "ground", "source", "target", "simulate"}, where)
@@ -449,6 +481,7 @@ def scene_from_mapping(doc: Mapping[str, Any], where: str = "scene") -> SceneSpe
         "seed": _number(sim, "seed", f"{where}.simulate", None, integer=True, minimum=0),
     }
     _plausible_pitch(aperture, float(np.max(fl)), where)
+    _plausible_ranges(aperture, medium, targets, float(np.max(fl)), where)
     if isinstance(source, GaussianBeam) and source.waist < C0 / float(np.max(fl)) / 4:
         raise ValueError(f"{where}.source.waist {source.waist:g} m is below a quarter "
                          "wavelength: such a beam is mostly evanescent (metres expected)")

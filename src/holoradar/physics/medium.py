@@ -119,33 +119,76 @@ class _Stack(NamedTuple):
     rho: list[np.ndarray]                            # reflection below interface j
 
 
-def check_ground_permittivity(eps: complex, name: str = "eps") -> complex:
-    """A ground permittivity a user gave: also refuse the likely slips.
+def ground_permittivity_problem(eps: Any) -> str | None:
+    """Why ``eps`` cannot be a ground's permittivity as a user gave it, or None.
 
     No ground is optically thinner than air, and a negative real part is a metal
     or a plasma, not soil: both are far likelier slips (a sign, a loss tangent
     or a conductivity typed in the permittivity's place) than the intended
-    medium. Used by :meth:`Medium.half_space`, :meth:`Medium.layered` and the
-    scene and command-line parsers; the bare constructor ``Medium(...)`` (used
-    by fits that explore trial values) does not refuse them.
+    medium. The real part is judged first: a sign slip also turns the loss of
+    ``eps' (1 + i tan_delta)`` negative, and the sign is the cause to name.
+
+    This is the one check of a permittivity that a user typed: the scene
+    files, ``--eps``, ``--layers`` and ``--medium`` and :meth:`Medium.half_space`,
+    :meth:`Medium.layered` all use it, so a slip reads the same wherever it is
+    made. The bare constructor ``Medium(...)`` (used by fits that explore
+    trial values) does not refuse these values.
+
+    Parameters
+    ----------
+    eps : complex
+        The permittivity as given (before a loss tangent or conductivity is
+        added).
+
+    Returns
+    -------
+    str or None
+        A sentence starting with the value (the caller puts the argument's
+        name before it), or None for a plausible ground.
+
+    Examples
+    --------
+    >>> print(ground_permittivity_problem(-2.5))  # doctest: +ELLIPSIS
+    -2.5 has a negative real part: a sign slip? ...
+    >>> ground_permittivity_problem(2.5 + 0.0125j) is None
+    True
+    """
+    try:
+        e = complex(eps)
+    except (TypeError, ValueError):
+        return f"{eps!r} is not a complex relative permittivity (e.g. sand 2.5+0.0125j)"
+    if not (np.isfinite(e.real) and np.isfinite(e.imag)):
+        return f"{eps!r} is not finite"
+    shown = f"{e.real:g}" if e.imag == 0 else f"{e.real:g}{e.imag:+g}j"
+    if e.real < 0:
+        return (f"{shown} has a negative real part: a sign slip? holoradar's permittivities "
+                "are eps' + i*eps'' with eps' >= 1 and loss as a positive imaginary part "
+                "(e.g. sand 2.5+0.0125j)")
+    if e.real < 1:
+        return (f"{shown} has a real part below 1 (air): no soil, rock or concrete has one; "
+                "was a loss tangent or a conductivity given in the permittivity's place? "
+                "(e.g. sand 2.5+0.0125j)")
+    if e.imag < 0:
+        return (f"{shown} has a negative imaginary part, a medium with gain: loss is a "
+                "positive imaginary part under exp(-i*omega*t) (e.g. sand 2.5+0.0125j)")
+    return None
+
+
+def check_ground_permittivity(eps: complex, name: str = "eps") -> complex:
+    """A ground permittivity a user gave, as a complex number; ``ValueError`` naming
+    ``name`` and the likely slip (:func:`ground_permittivity_problem`) otherwise.
 
     Examples
     --------
     >>> check_ground_permittivity(-2.5)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: eps = (-2.5+0j) has a negative real part: a sign slip? ...
+    ValueError: eps = -2.5 has a negative real part: a sign slip? ...
     """
-    e = _check_eps(eps, name)
-    if e.real < 0:
-        raise ValueError(f"{name} = {e} has a negative real part: a sign slip? holoradar's "
-                         "permittivities are eps' + i*eps'' with eps' >= 1 and loss as a "
-                         "positive imaginary part (e.g. sand 2.5+0.0125j)")
-    if e.real < 1:
-        raise ValueError(f"{name} = {e} has a real part below 1 (air): no soil, rock or "
-                         "concrete has one; was a loss tangent or a conductivity given in "
-                         "the permittivity's place? (e.g. sand 2.5+0.0125j)")
-    return e
+    problem = ground_permittivity_problem(eps)
+    if problem is not None:
+        raise ValueError(f"{name} = {problem}")
+    return complex(eps)
 
 
 def _check_eps(eps: complex, name: str) -> complex:

@@ -11,10 +11,15 @@ import numpy as np
 
 from .common import (
     Reporter,
+    array_of,
+    check_ground,
+    check_ranges,
     depth_ranges,
     medium_from_options,
     medium_options,
     output_options,
+    refuse_outside_planes,
+    warn_above_ground,
 )
 
 __all__ = ["COMMANDS"]
@@ -68,12 +73,18 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
 
     files = _expand(frames)
     zs = depth_ranges(z)
+    first = _first_frame(files, layout)
     freq = 1.0
     if medium_spec["sigma"] is not None:  # a conductivity needs the frequency
         from ...io import load
 
         freq = float(np.mean(load(files[0], layout=layout).frequencies))
     medium = medium_from_options(medium_spec, freq)
+    if first is not None:  # the ranges against the survey's array, before any frame is imaged
+        aperture, f_max = array_of(first)
+        check_ranges(zs, z, "--z", aperture, f_max, medium, escape=None)
+        check_ground(medium, medium_spec, aperture, f_max, escape=None)
+    warn_above_ground(zs, medium, medium_spec)
     s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
                   scheduler=scheduler, strict=strict, overwrite=force,
                   progress=report.progress and not report.as_json, layout=layout)
@@ -87,13 +98,50 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
         f"imaged {s['done']} frame(s), {s['resumed']} already done, {len(s['skipped'])} "
         f"skipped, in {s['seconds']:.1f} s ({s['scheduler']})",
         f"wrote {out}",
-    ])
+    ], result=[f"wrote {out}"])
+
+
+def _first_frame(files: list[Path], layout: str | None) -> Any:
+    """The first frame, to judge the ranges by its array; None when it cannot be read
+    (the run reports it by name and skips it, as any bad frame)."""
+    from ...io import load
+
+    try:
+        return load(files[0], layout=layout, check=False)
+    except (ValueError, OSError):
+        return None
+
+
+def _check_mosaic_options(store: Path, depth: float, z_surface: float | None) -> None:
+    """Refuse a --depth outside the stored planes (the nearest plane would be mapped
+    silently) and a --z-surface no frame's array can focus; warn when the surface lies
+    beyond the mapped plane."""
+    from ...data.plausibility import PlausibilityWarning
+    from ...survey.store import is_survey, stored_settings
+
+    if not is_survey(store):
+        return  # the mosaic names what the folder lacks
+    settings, geometry = stored_settings(store)
+    refuse_outside_planes(depth, settings.z, "--depth", "stored planes")
+    if z_surface is None:
+        return
+    aperture = max(geometry.nx * abs(geometry.pitch[0]), geometry.ny * abs(geometry.pitch[1]))
+    check_ranges(z_surface, f"{z_surface:g}", "--z-surface", aperture, max(geometry.frequency),
+                 what=f"a ground surface {z_surface:.4g} m", escape=None)
+    nearest = float(settings.z[np.argmin(np.abs(settings.z - depth))])
+    if z_surface > nearest:
+        import warnings
+
+        warnings.warn(f"--z-surface {z_surface:.4g} m lies beyond the mapped plane "
+                      f"({nearest:.4g} m): its depth is labelled negative, in the air",
+                      PlausibilityWarning, stacklevel=2)
 
 
 @click.command()
 @click.argument("store", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--depth", required=True, type=float,
-              help="Range of the plane (m); the stored plane nearest to it is used.")
+              help="Range of the plane (m); the stored plane nearest to it is used (one "
+                   "outside the stored planes is refused).")
 @click.option("--pitch", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Pixel step of the map, m (default: the frames' pixel step).")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
@@ -114,6 +162,7 @@ def mosaic(store: Path, depth: float, pitch: float | None, out: Path, db_range: 
     from ..atomic import write_atomic
 
     check_output(out, suffixes=[".png", ".nc"], inputs=[store], overwrite=force, name="--out")
+    _check_mosaic_options(store, depth, z_surface)
     img = run(store, depth, pitch=pitch)
     if out.suffix.lower() == ".nc":
         save(img, out, overwrite=force, history=[{"step": "mosaic", "input": store.name,
@@ -130,7 +179,7 @@ def mosaic(store: Path, depth: float, pitch: float | None, out: Path, db_range: 
         f"{img.x.size} x {img.y.size} pixels, brightest at x={pk[0] * 100:.1f} "
         f"y={pk[1] * 100:.1f} cm",
         f"wrote {out}",
-    ])
+    ], result=[f"wrote {out}"])
 
 
 COMMANDS = [batch, mosaic]

@@ -6,6 +6,8 @@ from __future__ import annotations
 import functools
 import json
 import math
+import re
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -13,13 +15,19 @@ from typing import Any
 import click
 import numpy as np
 
-__all__ = ["Reporter", "depth_ranges", "input_history", "layout_option", "medium_from_options",
-           "medium_options",
-           "output_options", "read_hologram"]
+__all__ = ["Reporter", "array_of", "check_ground", "check_planes", "check_ranges", "depth_ranges",
+           "input_history", "layout_option", "medium_from_options", "medium_options",
+           "output_options", "read_hologram", "refuse_outside_planes", "scaled",
+           "warn_above_ground"]
 
 
 class Reporter:
-    """Human lines unless ``--quiet``; with ``--json`` only the JSON summary on stdout."""
+    """What a command prints: its lines, or with ``--json`` only the JSON summary on stdout.
+
+    ``--quiet`` hides progress bars and the narrative lines, never the result: the
+    lines a command names as its result (the files it wrote, the answer it found)
+    are printed all the same, so that ``-q`` still says what came out.
+    """
 
     def __init__(self, as_json: bool, quiet: bool) -> None:
         self.as_json, self.quiet = as_json, quiet
@@ -30,15 +38,29 @@ class Reporter:
         return not self.quiet
 
     def line(self, text: str) -> None:
+        """A narrative line (hidden by ``--quiet`` and ``--json``)."""
         if not (self.quiet or self.as_json):
             click.echo(text)
 
-    def done(self, summary: dict[str, Any], lines: Sequence[str] = ()) -> None:
+    def done(self, summary: dict[str, Any], lines: Sequence[str] = (),
+             result: Sequence[str] | None = None) -> None:
+        """Print the outcome: ``summary`` as JSON with ``--json``, else ``lines``.
+
+        Parameters
+        ----------
+        summary : dict
+            The machine-readable summary (``--json``).
+        lines : sequence of str
+            Every line for a person, in order.
+        result : sequence of str, optional
+            The lines that are the command's result, printed even with ``--quiet``
+            (default: all of ``lines``, for commands whose every line is the answer).
+        """
         if self.as_json:
             click.echo(json.dumps(_plain(summary), indent=2))
-        elif not self.quiet:
-            for text in lines:
-                click.echo(text)
+            return
+        for text in (lines if not self.quiet or result is None else result):
+            click.echo(text)
 
 
 def _plain(v: Any) -> Any:
@@ -84,7 +106,7 @@ def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
                        "monostatic). A JSON sidecar FILE.json may hold it as \"layout\".")
     @click.option("--no-check", is_flag=True,
                   help="Skip the plausibility checks of units (pitch against wavelength, "
-                       "frequency in Hz, all-zero data).")
+                       "frequency in Hz, all-zero data, ranges and ground against the array).")
     @functools.wraps(fn)
     def wrapper(*args: Any, layout: str | None, no_check: bool, **kwargs: Any) -> Any:
         return fn(*args, layout=layout, check=not no_check, **kwargs)
@@ -156,6 +178,16 @@ def ground_table_from_options(spec: dict[str, Any]) -> dict[str, Any] | None:
     import tomllib
 
     from ...model.scene_file import parse_complex
+    from ...physics.medium import ground_permittivity_problem
+
+    def permittivity(text: str, name: str, where: str = "") -> complex:
+        # The one check of a typed permittivity (scene files use it too), judged as
+        # typed, before --tan-delta or --sigma adds the loss.
+        value = parse_complex(text, name)
+        problem = ground_permittivity_problem(value)
+        if problem is not None:
+            raise click.BadParameter(where + problem, param_hint=name)
+        return value
 
     eps, zs, td, sg = spec["eps"], spec["z_surface"], spec["tan_delta"], spec["sigma"]
     layers, mfile = spec["layers"], spec["medium_file"]
@@ -185,7 +217,9 @@ def ground_table_from_options(spec: dict[str, Any]) -> dict[str, Any] | None:
             if not sep or not math.isfinite(top_m):
                 raise click.BadParameter(f"each layer is TOP:EPS (m, permittivity), got "
                                          f"{part!r}", param_hint="--layers")
-            items.append({"top": top_m, "eps": parse_complex(value, "--layers eps"), **loss})
+            items.append({"top": top_m, "eps": permittivity(value, "--layers",
+                                                            f"layer {len(items) + 1}: "),
+                          **loss})
         return {"layer": items}
     if eps is None and zs is None:
         if loss:
@@ -195,7 +229,7 @@ def ground_table_from_options(spec: dict[str, Any]) -> dict[str, Any] | None:
     if eps is None or zs is None:
         raise click.BadParameter("give both --eps and --z-surface, or neither",
                                  param_hint="--eps/--z-surface")
-    return {"surface": zs, "eps": parse_complex(eps, "--eps"), **loss}
+    return {"surface": zs, "eps": permittivity(eps, "--eps"), **loss}
 
 
 def medium_from_options(spec: dict[str, Any], frequency: float) -> Any:
@@ -239,3 +273,135 @@ def triple(text: str, name: str) -> tuple[float, float, float]:
     if len(v) != 3 or not all(math.isfinite(e) for e in v):
         raise click.BadParameter(f"expected x,y,z in metres, got {text!r}", param_hint=name)
     return v  # type: ignore[return-value]
+
+
+# --- ranges against the array: a unit slip in an option is refused like one in a file ----
+
+def array_of(holo: Any) -> tuple[float, float]:
+    """The larger full width (n * pitch, m) and the highest frequency (Hz) of a hologram's
+    array (of an image: of its pixels, which span the array)."""
+
+    def width(v: np.ndarray) -> float:
+        v = np.asarray(v, dtype=float)
+        return float(np.ptp(v) * v.size / (v.size - 1)) if v.size > 1 else 0.0
+
+    return max(width(holo.x), width(holo.y)), float(np.max(holo.frequency))
+
+
+def scaled(text: str, factor: float) -> str:
+    """An option's numbers divided by a unit factor: ``35:55:0.5`` / 100 is
+    ``0.35:0.55:0.005`` (the form a user should have typed)."""
+    return "".join(p if p in (":", ",") else f"{float(p) / factor:.6g}"
+                   for p in re.split(r"([:,])", text.strip()))
+
+
+def check_ranges(ranges: Any, text: str, name: str, aperture: float, frequency: float,
+                 medium: Any = None, *, what: str | None = None, offset: float = 0.0,
+                 escape: str | None = "--no-check") -> None:
+    """Refuse ranges that no array of this width can focus (most likely centimetres or
+    millimetres typed for metres), naming the option and the metres meant.
+
+    Parameters
+    ----------
+    ranges : float or array_like
+        The ranges from the array plane the option asks for, metres.
+    text : str
+        The option's value as typed (for the corrected example).
+    name : str
+        The option, e.g. ``"--z"``.
+    aperture, frequency : float
+        The array's larger width (m) and highest frequency (Hz).
+    medium : Medium, optional
+        The ground: ranges below it are judged by their apparent range.
+    what : str, optional
+        How the message names the ranges (default their span in metres).
+    offset : float, optional
+        The surface's range, for values that are depths below it.
+    escape : str or None
+        The flag that skips the check, named in the message.
+
+    Raises
+    ------
+    click.BadParameter
+    """
+    from ...data.plausibility import range_problem, unit_slip
+
+    problem = range_problem(ranges, aperture, frequency, medium, what, offset)
+    if problem is None:
+        return
+    factor = unit_slip(ranges, aperture, frequency, medium, offset)
+    raise click.BadParameter(problem + _advice(
+        None if factor is None else f"{name} {scaled(text, factor)}", escape), param_hint=name)
+
+
+def _advice(example: str | None, escape: str | None) -> str:
+    """The way out of a refusal: the metres meant, and the flag that skips the check."""
+    parts = ([f"give metres, e.g. {example}"] if example else []) + \
+        ([f"{escape} takes the value as given"] if escape else [])
+    return f" ({'; '.join(parts)})" if parts else ""
+
+
+def _ground_flag(spec: dict[str, Any]) -> str:
+    return ("--medium" if spec.get("medium_file") is not None else
+            "--layers" if spec.get("layers") is not None else "--z-surface")
+
+
+def check_ground(medium: Any, spec: dict[str, Any], aperture: float, frequency: float, *,
+                 escape: str | None = "--no-check") -> None:
+    """Refuse a ground whose surface or layers lie where the array focuses nothing
+    (``--z-surface 30`` for 30 cm), naming the flag that gave it."""
+    if medium is None or medium.is_free_space:
+        return
+    name = _ground_flag(spec)
+    deepest = float(medium.z_interfaces[-1])
+    if name == "--z-surface":
+        check_ranges(deepest, f"{deepest:g}", name, aperture, frequency, medium,
+                     what=f"a ground surface {deepest:.4g} m", escape=escape)
+        return
+    from ...data.plausibility import range_problem
+
+    problem = range_problem(deepest, aperture, frequency, medium,
+                            f"a layer top at {deepest:.4g} m")
+    if problem is not None:
+        raise click.BadParameter(problem + _advice(None, escape), param_hint=name)
+
+
+def warn_above_ground(planes: Any, medium: Any, spec: dict[str, Any], name: str = "--z") -> None:
+    """Warn when every plane lies in the air above the ground: it can be meant (looking
+    at something above the surface), but the ground then plays no part."""
+    if medium is None or medium.is_free_space:
+        return
+    z = np.atleast_1d(np.asarray(planes, dtype=float))
+    surface = float(medium.z_interfaces[0])
+    if z.max() < surface:
+        from ...data.plausibility import PlausibilityWarning, _span
+
+        warnings.warn(f"every plane of {name} ({_span(z)} m) lies above the ground surface "
+                      f"at {surface:.4g} m ({_ground_flag(spec)}): the image is in air and "
+                      "the ground plays no part", PlausibilityWarning, stacklevel=2)
+
+
+def check_planes(holo: Any, zs: Any, text: str, medium: Any, spec: dict[str, Any],
+                 check: bool, name: str = "--z") -> None:
+    """The checks of an imaging command's ranges and ground against the hologram's array:
+    :func:`check_ranges`, :func:`check_ground`, :func:`warn_above_ground` (none with
+    ``--no-check``)."""
+    if not check:
+        return
+    aperture, frequency = array_of(holo)
+    check_ranges(zs, text, name, aperture, frequency, medium)
+    check_ground(medium, spec, aperture, frequency)
+    warn_above_ground(zs, medium, spec, name)
+
+
+def refuse_outside_planes(value: float, planes: Any, name: str, what: str) -> None:
+    """Refuse a range outside the planes a file or store holds (the nearest plane would
+    be taken silently), naming the likely unit slip and the metres meant."""
+    from ...data.plausibility import plane_problem
+
+    problem = plane_problem(value, planes, what)
+    if problem is None:
+        return
+    reason, factor = problem
+    raise click.BadParameter(reason + _advice(
+        f"{name} {value / factor:.6g}" if factor != 1.0 else None, None), param_hint=name)

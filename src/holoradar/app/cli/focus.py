@@ -11,6 +11,9 @@ import numpy as np
 
 from .common import (
     Reporter,
+    array_of,
+    check_ground,
+    check_ranges,
     layout_option,
     medium_from_options,
     medium_options,
@@ -100,6 +103,14 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
         raise click.BadParameter("autofocus needs a half-space ground: give --z-surface (and "
                                  "optionally --eps as the start, --tan-delta or --sigma)",
                                  param_hint="--z-surface")
+    if check:
+        aperture, f_max = array_of(holo)
+        check_ground(medium, medium_spec, aperture, f_max)
+        if depth_pair is not None and depth_range is not None:
+            surface = float(medium.z_interfaces[0])
+            check_ranges(depth_pair, depth_range, "--depth-range", aperture, f_max, medium,
+                         what=f"depths {depth_pair[0]:.4g}..{depth_pair[1]:.4g} m below the "
+                              f"surface at {surface:.4g} m", offset=surface)
     res = run(holo, medium_model=medium, eps_range=eps_pair, depth_range=depth_pair,
               position=at, glare=glare_arg, fit=fit, confidence=confidence,
               target=target, line_radius=line_radius, progress=report.progress)
@@ -112,6 +123,8 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
         else:
             lines.append(f"no plot: the search stopped before a sweep of eps' "
                          f"({plot_file} not written)")
+    # -q keeps the answer and what became of the plot asked for
+    result = [*lines, *[f"wrote {f}" for f in files]]
     summary = {
         "determinable": res.determinable, "eps": res.eps,
         "eps_interval": res.eps_interval, "confidence": res.confidence,
@@ -130,7 +143,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
                      f"{100 * res.line_length:.1f} cm")
     lines += [f"{res.eps_grid.size} trial eps', {res.evaluations} responses in "
               f"{res.seconds:.1f} s", *[f"wrote {f}" for f in files]]
-    report.done(summary, lines)
+    report.done(summary, lines, result=result)
 
 
 def _plot(res: Any, path: Path, title: str) -> None:

@@ -12,6 +12,7 @@ import numpy as np
 
 from .common import (
     Reporter,
+    check_planes,
     depth_ranges,
     input_history,
     layout_option,
@@ -94,6 +95,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
                      overwrite=force, name="--out's PNG")
     holo = read_hologram(hologram_file, layout, check)
     medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
+    check_planes(holo, zs, z, medium, medium_spec, check)
     t0 = time.perf_counter()
     img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
                   progress=report.progress)
@@ -115,7 +117,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
         f"pixels, in {seconds:.1f} s",
         f"brightest point x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
         *[f"wrote {f}" for f in files],
-    ])
+    ], result=[f"wrote {f}" for f in files])
 
 
 COMMANDS = [image]

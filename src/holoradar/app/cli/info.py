@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -112,10 +114,34 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
         except (ValueError, OSError):
             hist = []
         summary["history"] = hist
+        cut = False
         for step in hist:
             lines.append(f"  history: {step.get('step')} {step.get('time', '')} "
                          f"(holoradar {step.get('holoradar', '?')})")
+            text, short = _parameters(step)
+            cut = cut or short
+            lines += textwrap.wrap(text, 96, initial_indent=" " * 11,
+                                   subsequent_indent=" " * 13, break_long_words=False)
+        if cut:
+            lines.append("  (--json shows every parameter whole)")
     report.done(summary, lines)
+
+
+def _parameters(step: dict[str, Any]) -> tuple[str, bool]:
+    """A history step's input and parameters on one line (unset ones left out), and
+    whether a long value (a scene file's text) was shortened."""
+    items = {"input": step.get("input"), **(step.get("parameters") or {})}
+    parts, cut = [], False
+    for key, value in items.items():
+        if value is None:
+            continue
+        text = value if isinstance(value, str) else json.dumps(value)
+        if "\n" in text:
+            text, cut = f"<{len(text.splitlines())} lines>", True
+        elif len(text) > 80:
+            text, cut = text[:77] + "...", True
+        parts.append(f"{key}={text}")
+    return ", ".join(parts), cut
 
 
 COMMANDS = [info]

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .common import Reporter, output_options, triple
+from .common import Reporter, check_ranges, output_options, triple
 
 __all__ = ["COMMANDS"]
 
@@ -36,6 +36,7 @@ def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
     pc = s["image_peak_m"]["targets_only"]
     mf, me = s["glare"]["mirror_image_found_m"], s["glare"]["mirror_image_expected_m"]
     dz = th["longitudinal_resolution_m_in_ground"]
+    wrote = f"wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s"
     report.done({**s, "out": str(out), "seconds": time.perf_counter() - t0}, [
         "holoradar demo: paper lab stand, 16 x 16 array, 9.9 GHz, letter R 12 cm deep "
         "in sand (eps' 2.5, tan_delta 0.005)",
@@ -51,13 +52,13 @@ def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
         f"z={mf[2] * 100:.0f} cm (expected x={me[0] * 100:.1f} y={me[1] * 100:.1f})",
         f"  array pitch exceeds lambda/2: waves beyond {th['max_unaliased_angle_deg']:.0f} "
         "degrees off axis alias",
-        f"  wrote {len(s['files'])} files to {out}/ in {time.perf_counter() - t0:.1f} s",
+        f"  {wrote}",
         # the glare first (the hologram holds no direct wave), else the image is the glare
         f"  next: holoradar suppress {out}/hologram.nc --eps 2.5+0.0125j --z-surface 0.30 "
         "--method image_source --no-direct -o clean.nc",
         "        holoradar image clean.nc --z 0.30:0.60:0.005 --eps 2.5+0.0125j "
         "--z-surface 0.30 -o img.nc",
-    ])
+    ], result=[wrote])
 
 
 _POSITIVE = click.FloatRange(min=0, min_open=True)
@@ -137,6 +138,11 @@ def plan_oblique_cmd(n: int, pitch: float, center: str, tilt: float, azimuth: fl
     pose = Pose(c, tilt=np.radians(tilt), azimuth=np.radians(azimuth))
     ap = Aperture.grid(n, pitch, pose=pose)
     medium = Medium.half_space(z_surface, parse_complex(eps, "--eps"))
+    # ranges from the array's centre, against its width (centimetres typed for metres)
+    check_ranges(z_surface - c[2], f"{z_surface:g}", "--z-surface", n * pitch, frequency,
+                 what=f"a ground surface {z_surface:.4g} m", escape=None)
+    check_ranges(tg[2] - c[2], target, "--target", n * pitch, frequency, medium,
+                 what=f"a target at range {tg[2]:.4g} m", escape=None)
     src = PointSource(hp, pattern_exponent=pattern, axis=tuple(np.subtract(tg, hp)))
     plan = plan_oblique(ap, src, medium, tg, frequency=frequency)
     if out is not None:

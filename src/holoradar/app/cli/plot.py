@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
 
-from .common import Reporter, output_options
+from .common import Reporter, array_of, check_ranges, output_options
 
 __all__ = ["COMMANDS"]
 
@@ -54,6 +56,8 @@ def plot(file: Path, out: Path, zs: tuple[float, ...], db_range: float | None, s
         fig = plotting.plot_hologram(obj, file.name)
         shown: list[float] = []
     else:
+        if z_surface is not None:
+            _check_surface(obj, z_surface)
         pk = peak_position(obj)
         if section != "none":
             if not obj.has_z_axis or obj.z.size < 2:
@@ -76,6 +80,19 @@ def plot(file: Path, out: Path, zs: tuple[float, ...], db_range: float | None, s
     write_atomic(out, plotting.to_png(fig))
     report.done({"out": str(out), "kind": type(obj).__name__,
                  "planes_m": [float(v) for v in np.atleast_1d(shown)]}, [f"wrote {out}"])
+
+
+def _check_surface(img: Any, z_surface: float) -> None:
+    """Refuse a --z-surface the image's array cannot focus (centimetres for metres);
+    warn when it lies beyond every plane (every depth is labelled negative)."""
+    from ...data.plausibility import PlausibilityWarning
+
+    check_ranges(z_surface, f"{z_surface:g}", "--z-surface", *array_of(img),
+                 what=f"a ground surface {z_surface:.4g} m", escape=None)
+    if z_surface > float(np.max(img.z)):
+        warnings.warn(f"--z-surface {z_surface:.4g} m lies beyond every plane of the image "
+                      f"(the last at {float(np.max(img.z)):.4g} m): every depth is labelled "
+                      "negative, in the air", PlausibilityWarning, stacklevel=2)
 
 
 COMMANDS = [plot]

@@ -12,6 +12,9 @@ import numpy as np
 
 from .common import (
     Reporter,
+    array_of,
+    check_ground,
+    check_planes,
     depth_ranges,
     input_history,
     layout_option,
@@ -98,6 +101,8 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
     if medium is None:
         raise click.BadParameter("the glare needs a ground: give --eps and --z-surface, "
                                  "--layers or --medium", param_hint="--eps/--z-surface")
+    if check:
+        check_ground(medium, medium_spec, *array_of(holo))
     if method == "background" and background_file is None:
         raise click.BadParameter("--method background needs --background FILE",
                                  param_hint="--background")
@@ -122,7 +127,7 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
         f"glare suppressed by {rep.glare_suppression_db:.1f} dB at its mirror spot "
         f"({method}{'' if rep.converged else ', fit did not converge'}) in {seconds:.1f} s",
         *eps_line, f"wrote {out}",
-    ])
+    ], result=[*eps_line, f"wrote {out}"])
 
 
 @click.command()
@@ -179,6 +184,7 @@ def synthesize(hologram_files: tuple[Path, ...], z: str, medium_spec: dict[str, 
                                  " no source: give --horn or --plane-wave per view",
                                  param_hint="--horn/--plane-wave")
     medium = medium_from_options(medium_spec, float(np.mean(views[0].frequencies)))
+    check_planes(views[0], zs, z, medium, medium_spec, check)
     t0 = time.perf_counter()
     img = run(views, zs, medium=medium, mode=mode, upsample=upsample, frame=frame)
     seconds = time.perf_counter() - t0
@@ -193,7 +199,7 @@ def synthesize(hologram_files: tuple[Path, ...], z: str, medium_spec: dict[str, 
         f"synthesised {len(views)} views ({mode}) in {seconds:.1f} s",
         f"brightest point x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
         *[f"wrote {f}" for f in files],
-    ])
+    ], result=[f"wrote {f}" for f in files])
 
 
 COMMANDS = [suppress, synthesize]

@@ -53,7 +53,7 @@ def simulate(scene_file: Path, out: Path, force: bool, report: Reporter) -> None
         f"{'' if f.size == 1 else f'-{f.max() / 1e9:.4g}'} GHz), {s['targets']} target(s), "
         f"in {seconds:.1f} s",
         f"wrote {out}",
-    ])
+    ], result=[f"wrote {out}"])
 
 
 COMMANDS = [simulate]

@@ -9,7 +9,16 @@ from typing import Any
 import click
 import numpy as np
 
-from .common import Reporter, layout_option, medium_options, output_options
+from .common import (
+    Reporter,
+    array_of,
+    check_ground,
+    check_ranges,
+    layout_option,
+    medium_options,
+    output_options,
+    refuse_outside_planes,
+)
 
 __all__ = ["COMMANDS", "ground_from_options"]
 
@@ -112,10 +121,13 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         s = session.default_settings(ground=ground)
     if glare is not None:
         s = s.replace(glare=glare)
+    if check and session.kind == "holograms" and ground is not None:
+        check_ground(session.medium(s), medium_spec, *array_of(session.views[0]))
     if depth is not None:
         if not math.isfinite(depth):
             raise click.BadParameter(f"expected a depth in metres, got {depth}",
                                      param_hint="--depth")
+        _check_depth(session, s, depth, check)
         s = s.replace(depth=depth)
         if s.sweep is not None and not s.sweep[0] <= depth <= s.sweep[1]:
             # the slider spans the sweep: widen it to the depth asked for
@@ -140,6 +152,22 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         pass
     finally:
         server.stop()
+
+
+def _check_depth(session: Any, s: Any, depth: float, check: bool) -> None:
+    """Refuse a --depth outside an image's or a survey's planes (the nearest would be
+    shown silently), or one below the surface that the holograms' array cannot focus."""
+    if session.kind == "image":
+        refuse_outside_planes(depth, session.volume.z, "--depth", "image's planes")
+    elif session.kind == "survey":
+        refuse_outside_planes(depth, session.survey_z, "--depth", "stored planes")
+    elif check:
+        medium = session.medium(s)
+        surface = session.surface(s)
+        aperture, f_max = array_of(session.views[0])
+        check_ranges(depth, f"{depth:g}", "--depth", aperture, f_max, medium,
+                     what=f"a depth {depth:.4g} m below the surface at {surface:.4g} m"
+                     if surface else None, offset=surface)
 
 
 def _serve(session: Any, s: Any, host: str, port: int, export_dir: Path | None) -> Any:
@@ -226,7 +254,7 @@ def render(settings_file: Path, out: Path, png: bool, force: bool, layout: str |
         f"brightest point x={pk.x * 100:.2f} y={pk.y * 100:.2f} cm, "
         f"{'depth' if s.ground is not None and s.plane == 'image' else 'range'} "
         f"{(pk.z - surf) * 100:.2f} cm",
-        *[f"wrote {f}" for f in files]])
+        *[f"wrote {f}" for f in files]], result=[f"wrote {f}" for f in files])
 
 
 COMMANDS = [view, render]
