@@ -75,3 +75,19 @@ def test_beam_waist_below_the_surface_is_refused():
     h = hr.simulate(hr.Scene(SAND, hr.GaussianBeam(0.05), []), AP, F)
     with pytest.raises(ValueError, match="waist"):
         hr.suppress_surface(h, SAND, beam, method="gaussian")
+
+
+def test_image_source_refuses_a_direct_wave_reference_the_data_lack():
+    # The image-source fit takes the glare's strength relative to the direct wave; with no
+    # direct wave in the data its fitted amplitude is noise and eps runs off (1e6 was
+    # seen). Both entry points refuse alike, naming the way out.
+    m = hr.Medium.half_space(0.30, 2.5)
+    h = hr.simulate(hr.Scene(m, hr.PointSource((0.0, -0.05, 0.0))), hr.Aperture.grid(16, 0.02),
+                    9.9e9, include_direct=False, snr_db=40, seed=0)
+    with pytest.raises(ValueError, match="direct=False"):
+        hr.suppress_surface(h, m, method="image_source", direct=True)
+    with pytest.raises(ValueError, match="direct=False"):
+        hr.estimate_permittivity(h, m, direct=True)
+    _, rep = hr.suppress_surface(h, hr.Medium.half_space(0.30, 3.0), method="image_source",
+                                 direct=False)
+    assert abs(rep.eps.real - 2.5) < 2.5 * rep.eps_std[0]

@@ -36,6 +36,19 @@ def _direct_wave(src: Radiator, k: float, pts: np.ndarray,
     return unit.field(k, Medium.free_space(), pts)
 
 
+def _require_direct_wave(D: np.ndarray, h: np.ndarray) -> None:
+    """Refuse the direct wave as the glare's amplitude reference when the data hold
+    almost none of it (it explains < 1% of their energy): the fitted amplitude would
+    then be noise, and the glare's strength, hence eps, anything (a 1e6 was seen)."""
+    h = np.ravel(h)
+    share = abs(np.vdot(D, h)) ** 2 / max(np.vdot(D, D).real * np.vdot(h, h).real, 1e-300)
+    if share < 0.01:
+        raise ValueError("direct=True takes the radiator's direct wave as the amplitude "
+                         "reference, but the hologram holds almost none of it (the direct "
+                         "wave explains <1% of it): pass direct=False (holoradar suppress "
+                         "--no-direct) with a calibrated source amplitude")
+
+
 def _joint_direct(h: np.ndarray, glare: np.ndarray, D: np.ndarray | None
                   ) -> tuple[complex | None, np.ndarray, np.ndarray]:
     """Fit the direct wave's amplitude to what the glare leaves."""

@@ -4,13 +4,11 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _direct_wave, _recorded
+from ._common import _direct_wave, _recorded, _require_direct_wave
 from .suppress import suppress_surface
 
 __all__ = ["estimate_permittivity"]
@@ -48,13 +46,7 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     """
     src = source if source is not None else getattr(hologram, "source", None)
     if direct and isinstance(src, PointSource | GaussianBeam | Dipole):
-        D = _direct_wave(src, hologram.k, hologram.points, _recorded(hologram, src))
-        h = hologram.data.ravel()
-        share = abs(np.vdot(D, h)) ** 2 / (np.vdot(D, D).real * np.vdot(h, h).real)
-        if share < 0.01:
-            raise ValueError("direct=True takes the radiator's direct wave as the amplitude "
-                             "reference, but the hologram holds almost none of it (the direct "
-                             "wave explains <1% of it): pass direct=False with a calibrated "
-                             "source amplitude")
+        _require_direct_wave(_direct_wave(src, hologram.k, hologram.points,
+                                          _recorded(hologram, src)), hologram.data)
     _, rep = suppress_surface(hologram, medium, source, "image_source", direct=direct)
     return rep.eps, rep.eps_std

@@ -22,7 +22,7 @@ from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.propagation import AngularSpectrum
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _direct_wave, _joint_direct, _recorded
+from ._common import _direct_wave, _joint_direct, _recorded, _require_direct_wave
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source
 
@@ -288,6 +288,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     pol = _recorded(hologram, src)
     D = _direct_wave(src, k, pts, pol) if direct else None
     h = data.ravel()
+    if D is not None and method == "image_source":
+        _require_direct_wave(D, h)
     report_kw: dict[str, Any] = {"mirror_plane": z_m}
     if method == "cut":
         r = cut_radius if cut_radius is not None else 1.5 * cell
