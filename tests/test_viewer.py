@@ -343,3 +343,57 @@ def test_view_names_the_flag_that_is_wrong(scene, tmp_path):
     r = CliRunner().invoke(main, ["view", str(vol), "--no-browser", "--eps", "2.5",
                                   "--z-surface", "0.3"])
     assert r.exit_code == 2 and "apply to holograms" in r.output
+
+
+def test_served_page_says_it_is_loading_before_the_document_arrives(scene):
+    # The page is drawn by BokehJS from the document sent over the websocket: the HTML
+    # itself must say something, or a plain screenshot (and a slow start) is blank.
+    from tornado.httpclient import AsyncHTTPClient
+
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    server = make_server(S, S.default_settings(ground=SAND), export_dir=Path("."))
+    try:
+        url = url_of(server, "127.0.0.1")
+        resp = server.io_loop.run_sync(lambda: AsyncHTTPClient().fetch(url), timeout=120)
+    finally:
+        server.stop()
+    html = resp.body.decode()
+    assert resp.code == 200
+    loading = html.find("loading the holoradar viewer...")
+    # before the page's root, which BokehJS fills once the document has arrived
+    assert 0 <= loading < html.index("data-root-id")
+
+
+def test_page_layout_stretches_and_fits_a_1000_px_window(scene, tmp_path):
+    # Fixed controls beside a plan view that takes what the window leaves (between its
+    # minimum and maximum) and fixed-width sections: at their smallest they fit 1000 px,
+    # less a scrollbar. (The browser test looks at the page at 1000 x 800.)
+    from bokeh.document import Document
+
+    from holoradar.app.view.page import ViewerPage
+
+    paths, _, _ = scene
+    S = ViewSession(paths)
+    doc = Document()
+    page = ViewerPage(doc, S, S.default_settings(ground=SAND), tmp_path)
+    root = doc.roots[0]
+    assert root.sizing_mode == "stretch_width"
+    controls, main = root.children
+    assert controls.sizing_mode in (None, "fixed") and main.sizing_mode == "stretch_width"
+    assert page.fig.sizing_mode == "stretch_width"
+    assert page.fig.min_width < page.fig.max_width
+    sections = main.children[0].children[1]
+    assert page.xz in sections.children and page.yz in sections.children
+    def side_margins(model) -> int:  # left + right, as Bokeh takes its margin property
+        m = model.margin or 0
+        return 2 * m if isinstance(m, int) else m[1] + m[3]
+
+    scrollbar = 20
+    narrowest = sum(w + side_margins(m) for w, m in ((controls.width, controls),
+                                                     (page.fig.min_width, page.fig),
+                                                     (sections.width, sections)))
+    assert narrowest <= 1000 - scrollbar
+    assert all(w.width <= controls.width for w in controls.children if w.width)
+    # every figure below the plan stretches too
+    assert all(f.sizing_mode == "stretch_width" for f in page.hfigs)

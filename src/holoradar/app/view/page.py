@@ -27,6 +27,31 @@ __all__ = ["ViewerPage"]
 _GLARE_LABELS = {"off": "off", "gaussian": "Gaussian beam fit", "image_source": "image source",
                  "cut": "mirror-plane cut"}
 
+# The page's widths (px). The controls keep theirs; the plan view, its readouts and the
+# hologram row share what the window leaves beside them. At the smallest the controls,
+# the plan view and the sections take 300 + 360 + 300 px (+ margins): a 1000 px wide
+# window shows them all side by side; a wider one gives the plan view up to 700 px.
+CONTROLS_WIDTH = 300
+PLAN_MIN_WIDTH = 360
+PLAN_MAX_WIDTH = 700
+SECTION_WIDTH = 300
+
+LOADING_TEXT = "loading the holoradar viewer..."
+# The served page itself says it is loading: Bokeh builds the page in the browser from
+# the document sent over the websocket, and until then a page without this (a plain
+# `chromium --headless --screenshot`, a slow first sweep) is blank. The text goes once
+# the document has been drawn (Bokeh's DocumentReady event, below).
+PAGE_TEMPLATE = f"""
+{{% block contents %}}
+<div id="holoradar-loading" style="font: 16px sans-serif; color: #555; padding: 2em;">
+  {LOADING_TEXT}
+  <noscript>(the viewer needs JavaScript)</noscript>
+</div>
+{{{{ super() }}}}
+{{% endblock %}}
+"""
+_DROP_LOADING = "const el = document.getElementById('holoradar-loading'); if (el) el.remove();"
+
 
 def _edges(c: np.ndarray, unit: float = CM) -> tuple[float, float]:
     """Left edge and width of pixels centred on ``c``, times ``unit`` (default: in cm)."""
@@ -106,13 +131,14 @@ class ViewerPage:
 
         s, S = self.s, self.session
         holo = S.kind == "holograms"
-        self.status = Div(text="", name="status", width=330)
-        self.info = Div(text=self._info_text(), name="info", width=330)
+        self.status = Div(text="", name="status", width=CONTROLS_WIDTH - 10)
+        self.info = Div(text=self._info_text(), name="info", width=CONTROLS_WIDTH - 10)
         a, b = s.sweep if s.sweep is not None else (0.0, 0.25)
         label = "depth below the surface (cm)" if s.ground is not None else "range z (cm)"
         step = max((b - a) / 500, 1e-4)
         self.depth = Slider(title=label, start=a * CM, end=b * CM, step=step * CM,
-                            value=min(max(s.depth, a), b) * CM, name="depth", width=320)
+                            value=min(max(s.depth, a), b) * CM, name="depth",
+                            width=CONTROLS_WIDTH - 20)
         self.depth.on_change("value", lambda _a, _o, _n: self._syncing or self._schedule_plane())
         self.sweep_a = Spinner(title="sweep from (cm)", value=round(a * CM, 3), step=0.5,
                                width=100, format="0[.]00",
@@ -162,19 +188,19 @@ class ViewerPage:
         self.direct = CheckboxGroup(labels=["remove the direct wave too"],
                                     active=[0] if s.direct else [], name="direct")
         self.direct.on_change("active", lambda _a, _o, n: self._set(direct=bool(n)))
-        self.glare_report = Div(text="", name="glare_report", width=330)
+        self.glare_report = Div(text="", name="glare_report", width=CONTROLS_WIDTH - 10)
         # views and frequencies
         names = S.names if holo else []
         use = list(range(len(names))) if s.views is None else list(s.views)
         self.views = CheckboxGroup(labels=names, active=use, name="views")
         self.views.on_change("active", lambda _a, _o, n: self._set_views(n))
         self.mode = Select(title="synthesis", options=list(MODES), value=s.mode, name="mode",
-                           width=150)
+                           width=140)
         self.mode.on_change("value", lambda _a, _o, n: self._set(mode=n))
         fopts = [("coherent", "all, coherent sum"), ("incoherent", "all, incoherent sum")]
         fopts += [(str(i), f"{f / 1e9:.4g} GHz") for i, f in enumerate(S.frequencies)]
         self.freq = Select(title="frequencies", options=fopts, value=str(s.frequency),
-                           name="frequency", width=150)
+                           name="frequency", width=140)
         self.freq.on_change("value", lambda _a, _o, n: self._set(
             frequency=n if n in ("coherent", "incoherent") else int(n)))
         self.frame = Select(title="planes", value=s.frame, name="frame", width=150,
@@ -184,17 +210,18 @@ class ViewerPage:
         # clicks
         self.click = RadioButtonGroup(labels=["click measures", "click places sections"],
                                       active=0, name="click")
-        self.readout = Div(text="cursor: -", name="readout", width=330)
+        self.readout = Div(text="cursor: -", name="readout", sizing_mode="stretch_width")
         # Drawn on the plot's canvas: a Div's new text would re-lay out the whole page on
         # every slider step (about 8 ms in Chromium).
         self.peak = Label(x=6, y=6, x_units="screen", y_units="screen", text="", name="peak",
                           text_color="white", text_font_size="10pt",
                           background_fill_color="black", background_fill_alpha=0.6)
-        self.ruler = Div(text="distance: click two points", name="distance", width=330)
+        self.ruler = Div(text="distance: click two points", name="distance",
+                         sizing_mode="stretch_width")
         clear = Button(label="clear points", width=100, name="clear")
         clear.on_click(lambda: self._clear_points())
         # export
-        self.exported = Div(text="", name="exported", width=330)
+        self.exported = Div(text="", name="exported", width=CONTROLS_WIDTH - 10)
         buttons = []
         for what in ("PNG", "NetCDF", "settings"):
             bt = Button(label=f"export {what}", width=105, name=f"export_{what.lower()}")
@@ -208,9 +235,9 @@ class ViewerPage:
                                           "x": [0.0], "y": [0.0], "dw": [1.0], "dh": [1.0]},
                                     name="image_source")
         tools = "pan,wheel_zoom,box_zoom,reset,save,tap"
-        self.fig = figure(title="plan view", width=520, height=480, tools=tools,
-                          match_aspect=True, x_axis_label="x (cm)", y_axis_label="y (cm)",
-                          name="plan")
+        self.fig = figure(title="plan view", height=460, tools=tools, sizing_mode="stretch_width",
+                          min_width=PLAN_MIN_WIDTH, max_width=PLAN_MAX_WIDTH, match_aspect=True,
+                          x_axis_label="x (cm)", y_axis_label="y (cm)", name="plan")
         self.plan = self.fig.image(image="db", x="x", y="y", dw="dw", dh="dh",
                                    source=self.src, color_mapper=self.mapper)
         self.bar = ColorBar(color_mapper=self.mapper, title="|E| (dB re sweep peak)",
@@ -234,10 +261,12 @@ class ViewerPage:
                                              "x": [0.0], "y": [0.0], "dw": [1], "dh": [1]})
         self.yz_src = ColumnDataSource(data=dict(self.xz_src.data))
         ylabel = "depth (cm)" if s.ground is not None else "range z (cm)"
-        self.xz = figure(title="x-z section", width=420, height=230, x_axis_label="x (cm)",
-                         y_axis_label=ylabel, tools="pan,wheel_zoom,reset,save", name="xz")
-        self.yz = figure(title="y-z section", width=420, height=230, x_axis_label="y (cm)",
-                         y_axis_label=ylabel, tools="pan,wheel_zoom,reset,save", name="yz")
+        self.xz = figure(title="x-z section", width=SECTION_WIDTH, height=215,
+                         x_axis_label="x (cm)", y_axis_label=ylabel,
+                         tools="pan,wheel_zoom,reset,save", name="xz")
+        self.yz = figure(title="y-z section", width=SECTION_WIDTH, height=215,
+                         x_axis_label="y (cm)", y_axis_label=ylabel,
+                         tools="pan,wheel_zoom,reset,save", name="yz")
         self.depth_marks = []
         for f, src in ((self.xz, self.xz_src), (self.yz, self.yz_src)):
             f.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src,
@@ -260,7 +289,8 @@ class ViewerPage:
                 ("phase (rad)", self.h_phase, "Turbo256", ("x (cm)", "y (cm)")),
                 ("spectral window (dB)", self.h_spec, "Magma256",
                  ("kx / k", "ky / k"))):
-            f = figure(title=title, width=280, height=260, tools="pan,wheel_zoom,reset,save",
+            f = figure(title=title, height=250, tools="pan,wheel_zoom,reset,save",
+                       sizing_mode="stretch_width", min_width=200, max_width=320,
                        match_aspect=True, x_axis_label=lab[0], y_axis_label=lab[1])
             m = LinearColorMapper(palette=pal)
             f.image(image="image", x="x", y="y", dw="dw", dh="dh", source=src, color_mapper=m)
@@ -300,21 +330,29 @@ class ViewerPage:
             self.glare, self.direct, self.glare_report, self.which,
             Div(text="<b>views</b>"), self.views, row(self.mode, self.freq), self.frame,
             row(self.scale, self.db_range), self.click, clear, row(*buttons[:2]),
-            buttons[2], self.exported, width=340)
-        readouts = column(self.readout, self.ruler)
+            buttons[2], self.exported, width=CONTROLS_WIDTH)
+        readouts = column(self.readout, self.ruler, sizing_mode="stretch_width")
         # The hologram row only where holograms were opened (an image has none).
-        holo_row = row(column(self.holo_view, self.hfigs[0]), self.hfigs[1], self.hfigs[2],
-                       visible=holo)
+        holo_row = row(column(self.holo_view, self.hfigs[0], sizing_mode="stretch_width",
+                              max_width=320),
+                       self.hfigs[1], self.hfigs[2], visible=holo, sizing_mode="stretch_width",
+                       max_width=PLAN_MAX_WIDTH + SECTION_WIDTH)
         # A survey's mosaic is one plane at a time: no sections.
-        plots = [column(self.fig, readouts)] + ([column(self.xz, self.yz)]
-                                                if S.kind != "survey" else [])
-        layout = row(controls, column(row(*plots), holo_row))
+        plots = [column(self.fig, readouts, sizing_mode="stretch_width",
+                        max_width=PLAN_MAX_WIDTH)] + (
+            [column(self.xz, self.yz, width=SECTION_WIDTH)] if S.kind != "survey" else [])
+        # Fixed controls, the rest stretched to the window (see CONTROLS_WIDTH).
+        layout = row(controls, column(row(*plots, sizing_mode="stretch_width"), holo_row,
+                                      sizing_mode="stretch_width"),
+                     sizing_mode="stretch_width", name="layout")
         if not holo:
             for w in (self.ground_kind, self.surface, self.eps_re, self.eps_im, self.glare,
                       self.direct, self.which, self.mode, self.freq, self.frame,
                       self.holo_view):
                 w.disabled = True
         self.doc.add_root(layout)
+        self.doc.template = PAGE_TEMPLATE
+        self.doc.js_on_event("document_ready", CustomJS(code=_DROP_LOADING))
         self.doc.title = f"holoradar view: {', '.join(p.name for p in S.paths)}"
 
     def _info_text(self) -> str:
