@@ -16,6 +16,7 @@ Examples
 
 from . import calibrate, survey, theory
 from ._validate import AliasingWarning
+from .analysis.detect import detect
 from .analysis.oblique_plan import ObliquePlan, plan_oblique
 from .data.hologram import C0, Hologram, Image
 from .data.pose import Pose
@@ -78,6 +79,7 @@ __all__ = [
     "calibrate",
     "check_iq_sign",
     "conjugate",
+    "detect",
     "estimate_permittivity",
     "iq_convention",
     "load",

@@ -1,0 +1,178 @@
+"""``detect``: the objects in an image, one row each."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .clean import CleanResult, clean
+from .grid import Volume, as_volume
+from .table import COLUMNS, as_eps_interval, depth_interval
+
+__all__ = ["detect"]
+
+_KINDS = ("point", "line", "area")
+
+
+def _check(false_alarm: Any, kinds: Any, medium: Any, eps_interval: Any) -> tuple[float, set[str]]:
+    try:
+        fa = float(false_alarm)
+    except (TypeError, ValueError):
+        fa = np.nan
+    if not (0 < fa <= 0.1):
+        raise ValueError("false_alarm must be a probability per resolution cell in (0, 0.1], "
+                         f"got {false_alarm!r}")
+    if isinstance(kinds, str) or not isinstance(kinds, Sequence | set | frozenset):
+        raise ValueError(f"kinds must be a sequence drawn from {_KINDS}, got {kinds!r}")
+    ks = set(kinds)
+    bad = ks - set(_KINDS)
+    if bad or not ks:
+        raise ValueError(f"kinds must be a non-empty sequence drawn from {_KINDS}, got {kinds!r}")
+    if medium is not None and not hasattr(medium, "z_interfaces"):
+        raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
+    if eps_interval is not None and (medium is None or not medium.z_interfaces):
+        raise ValueError("eps_interval gives a depth interval, which needs medium= (a ground "
+                         "with a surface)")
+    return fa, ks
+
+
+def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
+           false_alarm: float = 1e-3, kinds: Sequence[str] = _KINDS,
+           hologram: Any = None, migrate_options: Mapping[str, Any] | None = None,
+           max_objects: int = 100) -> Any:
+    """The objects in an image: what, where, how deep, how big, how sure.
+
+    Parameters
+    ----------
+    image : Image
+        A plane ``(ny, nx)`` or a volume ``(nz, ny, nx)`` with coordinates in metres
+        (one frame; a wideband image summed over its frequencies). Sample it at
+        several pixels per resolution cell (``migrate(..., upsample=4)`` or finer).
+    medium : Medium, optional
+        The ground the image was formed through: depths are ranges below its first
+        interface (``depth`` columns are NaN without it).
+    eps_interval : (float, float) or AutofocusResult, optional
+        Interval of the ground's real permittivity (e.g. ``autofocus``'s 95 %
+        interval): widens ``depth_low``/``depth_high`` (needs ``medium``).
+    false_alarm : float
+        Expected number of false objects per resolution cell on noise (default
+        1e-3); sets the threshold from the image's own noise (docs/detect.md).
+    kinds : sequence of str
+        Which kinds to report: ``"point"``, ``"line"`` (``"area"`` is accepted;
+        areas are not detected yet).
+    hologram : Hologram, optional
+        The hologram the image was migrated from (one frame, level aperture). With
+        it each object is the exact point response fitted to the hologram: its
+        position is the fit's (no pull towards the array), with a Cramer-Rao
+        standard deviation, and CLEAN subtracts its exact image. Without it, the
+        image's analytic point response (the spectral window) and its peak.
+    migrate_options : mapping, optional
+        Keyword arguments of ``migrate`` other than ``medium`` and ``upsample`` the
+        image was made with (checked: the image must equal the hologram's migration).
+    max_objects : int
+        CLEAN's limit.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per object with the columns :data:`~holoradar.analysis.detect.table.COLUMNS`:
+        ``kind``; ``x``, ``y``, ``range`` (metres, the image's axes; the range from
+        the aperture); ``depth`` below the surface with ``depth_low``/``depth_high``
+        (95 %: the range's uncertainty and the permittivity's interval); ``length``,
+        ``width``, ``azimuth_deg`` (degrees from +x towards +y; lines),
+        ``x_start``, ``y_start``, ``x_end``, ``y_end`` (a line's ends), ``spacing``
+        (to the nearest parallel line); ``amplitude_db`` (20 log10 of the object's
+        image amplitude), ``snr_db`` (its intensity over the local noise),
+        ``x_std``, ``y_std``, ``range_std`` (metres), ``model_error_db`` (what the
+        model leaves of the object, relative, dB). ``df.attrs`` holds the threshold,
+        the noise and the cell.
+
+    Raises
+    ------
+    ValueError
+        An image without coordinates, a bad ``false_alarm`` or ``kinds``, an
+        ``eps_interval`` that is not an interval or without a ``medium``, a
+        hologram that did not make the image.
+
+    Examples
+    --------
+    >>> import numpy as np, holoradar as hr
+    >>> scene = hr.Scene(hr.Medium.free_space(), hr.PlaneWave(),
+    ...                  [hr.PointTarget((0.02, 0.0, 0.5))])
+    >>> h = hr.simulate(scene, hr.Aperture.grid(24, 0.0125), 9.9e9, snr_db=30, seed=1)
+    >>> img = hr.migrate(h, np.arange(0.44, 0.57, 0.03), upsample=4)
+    >>> df = detect(img, hologram=h)
+    >>> len(df), round(float(df.x[0]), 2), round(float(df.range[0]), 2)
+    (1, 0.02, 0.5)
+    """
+    import pandas as pd
+
+    fa, ks = _check(false_alarm, kinds, medium, eps_interval)
+    interval = as_eps_interval(eps_interval)
+    vol = as_volume(image)
+    if hologram is not None:
+        from .model import HologramModel
+
+        model: Any = HologramModel(hologram, vol, medium, dict(migrate_options or {}))
+    else:
+        if migrate_options:
+            raise ValueError("migrate_options needs hologram=")
+        if vol.z.size > 1:
+            raise ValueError("image: a volume (several ranges) needs hologram= (a point's "
+                             "response along range comes from the hologram); without it pass "
+                             "one plane, e.g. image.plane(z)")
+        from .window import WindowModel
+
+        model = WindowModel(vol, medium)
+    result = clean(vol, model, fa, max_objects=int(max_objects))
+    rows = _rows(result, vol, model, medium, interval)
+    if "line" in ks:
+        from .lines import group_lines
+
+        rows = group_lines(rows, result.noise.cell)
+    if "point" not in ks:
+        rows = [r for r in rows if r["kind"] != "point"]
+    df = pd.DataFrame(rows, columns=COLUMNS)
+    df.attrs.update({"threshold": float(result.noise.t), "false_alarm": fa,
+                     "resolution_cell": [float(c) for c in result.noise.cell],
+                     "n_cells": float(result.noise.n_cells),
+                     "model": model.kind})
+    return df
+
+
+def _rows(result: CleanResult, vol: Volume, model: Any, medium: Any,
+          interval: tuple[float, float] | None) -> list[dict[str, Any]]:
+    stds: list[Any] = [c.std for c in result.components]
+    positions = [c.position for c in result.components]
+    if getattr(model, "kind", "") == "hologram" and result.components:
+        model.refine()
+        positions = [tuple(float(v) for v in ob["r"]) for ob in model.objects]
+        stds = [tuple(float(v) for v in s) for s in model.uncertainty()]
+    wideband = np.atleast_1d(vol.frequency).size > 1 if vol.frequency is not None else False
+    rows = []
+    for c, pos, std in zip(result.components, positions, stds, strict=True):
+        s2 = float(result.noise.sigma2[c.peak_index])
+        amp2 = abs(c.amplitude) ** 2
+        snr = 10 * np.log10(amp2 / s2) if s2 > 0 else np.inf
+        if not np.all(np.isfinite(std)) and getattr(model, "kind", "") == "window":
+            mu, nu = model.widths(pos[2])
+            snr_lin = amp2 / s2 if s2 > 0 else np.inf
+            # Cramer-Rao of a peak's position: 1/sqrt(2 SNR beta^2), beta^2 = mu^2/3.
+            std = (np.sqrt(3 / (2 * snr_lin)) / mu, np.sqrt(3 / (2 * snr_lin)) / nu, np.nan)
+        depth = lo = hi = np.nan
+        if medium is not None and medium.z_interfaces:
+            z0 = float(medium.z_interfaces[0])
+            depth = pos[2] - z0
+            eps = float(np.real(medium.eps[int(medium.region_of(pos[2]))]))
+            lo, hi = depth_interval(depth, std[2], eps, interval, wideband)
+        rows.append({"kind": "point", "x": pos[0], "y": pos[1], "range": pos[2],
+                     "depth": depth, "depth_low": lo, "depth_high": hi,
+                     "length": 0.0, "width": 0.0, "azimuth_deg": np.nan,
+                     "amplitude_db": 20 * np.log10(max(abs(c.amplitude), 1e-300)),
+                     "snr_db": snr, "x_std": std[0], "y_std": std[1], "range_std": std[2],
+                     "x_start": np.nan, "y_start": np.nan, "x_end": np.nan, "y_end": np.nan,
+                     "spacing": np.nan,
+                     "model_error_db": 20 * np.log10(max(c.model_error, 1e-6))})
+    return rows

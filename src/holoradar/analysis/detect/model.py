@@ -1,0 +1,237 @@
+"""The image of a point from the hologram: exact responses, fitted positions.
+
+With the hologram that made the image, each object is a point scatterer fitted
+to the hologram: its exact field at the elements ``g(r)`` (the layered Green's
+function times the source's incident field, :class:`~holoradar.imaging.
+point_response.PointResponse`, the model ``autofocus`` fits), its position ``r``
+the maximum of the normalised matched filter
+
+    F(r) = |<h_res, g(r)>|^2 / (||g(r)||^2 ||h_res||^2)
+
+on the residual hologram ``h_res`` (the hologram less the objects found). Unlike
+the image's amplitude maximum, this is the maximum-likelihood position of one
+point in white noise: it has no pull towards the array (the adjoint's ``1/r``
+weighting and the long focus of one frequency do not enter). The object's image
+is ``migrate(a g)`` with the image's own settings: CLEAN subtracts the exact
+response, sidelobes and range smear included, and the residual image is the
+migration of ``h_res`` (migration is linear once its data-dependent settings,
+the frequency weights and the loss compensation's SNR, are fixed to the
+original hologram's).
+
+Position uncertainty: the Cramer-Rao bound of the fit, ``Cov = J^-1`` with
+``J = (2 |a|^2 / s^2) Re[D^H P D]``, ``D`` the derivatives of ``g`` along x, y, z,
+``P`` the projection orthogonal to ``g`` (the amplitude is fitted too) and ``s^2``
+the noise variance per element, estimated from the final residual hologram
+(anything the models leave counts as noise: the bound is then conservative).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.optimize import minimize
+
+from ...data.hologram import Hologram
+from ...imaging.migrate import _data_snr, _weights, migrate
+from ...imaging.point_response import PointResponse
+from ...physics.medium import Medium
+from .grid import Volume
+
+__all__ = ["HologramModel"]
+
+
+class HologramModel:
+    """Point responses fitted to the hologram behind an image.
+
+    Parameters
+    ----------
+    hologram : Hologram
+        One frame (one or several frequencies) on a level aperture (identity pose).
+    volume : Volume
+        The image: ``migrate(hologram, z, medium=medium, upsample=u, **options)``.
+    medium : Medium, optional
+        The ground the image was formed through (None: free space).
+    options : dict, optional
+        Further keyword arguments the image was migrated with.
+    """
+
+    kind = "hologram"
+
+    def __init__(self, hologram: Hologram, volume: Volume, medium: Medium | None,
+                 options: dict[str, Any] | None = None) -> None:
+        if not isinstance(hologram, Hologram):
+            raise ValueError("hologram must be a holoradar.Hologram, got "
+                             f"{type(hologram).__name__}")
+        shape = hologram.data.shape
+        if len(shape) != (3 if hologram.is_wideband else 2):
+            raise ValueError("hologram must hold one frame (ny, nx) or (nf, ny, nx); got shape "
+                             f"{shape}: select the frame the image was made from")
+        if not np.allclose(hologram.points[:, 2], 0.0) or hologram.pose.normal[2] < 1 - 1e-12:
+            raise ValueError("hologram must lie on a level aperture at z = 0 (identity pose) "
+                             "for detect's point fit; tilted arrays are not supported yet")
+        dx = hologram.pitch[0]
+        u = round(dx / volume.dx)
+        expect_x = hologram.x[0] + np.arange(u * (hologram.x.size - 1) + 1) * dx / u
+        if u < 1 or expect_x.size != volume.x.size or not np.allclose(expect_x, volume.x,
+                                                                      atol=1e-9 + 1e-6 * dx):
+            raise ValueError("image does not come from hologram: its x grid is not the "
+                             "elements' at an integer upsampling (migrate(..., upsample=u), "
+                             "fov='aperture')")
+        self.hologram = hologram
+        self.vol = volume
+        self.medium = medium
+        opts = dict(options or {})
+        opts.setdefault("upsample", u)
+        if hologram.is_wideband and isinstance(opts.get("equalize", True), bool | np.bool_):
+            # The weights of the original hologram: the residual's would differ.
+            opts["equalize"] = _weights(hologram, opts.get("equalize", True))
+        if opts.get("snr_db") is None:
+            opts["snr_db"] = _data_snr(hologram, medium, volume.z)
+        self.options = opts
+        self.eps = {}
+        # Free space as a "ground" of eps 1 + 1e-6 from half the image's first range (eps
+        # exactly 1 puts a quadrature node on the Green integral's branch point; the
+        # difference is a phase of 5e-7 k z, 5e-5 rad at 50 cm; an interface close to
+        # the aperture would make the integrals slow).
+        pr_medium = medium if medium is not None and not medium.is_free_space else \
+            Medium.half_space(0.5 * float(volume.z[0]), 1.0 + 1e-6)
+        self.z_min = pr_medium.z_interfaces[0]
+        coherent = bool(hologram.monostatic or hologram.source is not None)
+        self.pr = PointResponse(hologram, lambda e: pr_medium, coherent=coherent)
+        self.pr_medium = pr_medium
+        self.h = hologram.data.reshape(hologram.nf, -1).astype(complex)
+        self.res = self.h.copy()
+        self.objects: list[dict[str, Any]] = []
+
+    # ------------------------------------------------------------------ images
+    def image(self, data: np.ndarray) -> np.ndarray:
+        """The migration of hologram data (nf, N) with the image's settings, (nz, ny, nx)."""
+        h = self.hologram.with_data(data.reshape(self.hologram.data.shape))
+        z = self.vol.z if not self.vol.planar else float(self.vol.z[0])
+        img = migrate(h, z, medium=self.medium, **self.options)
+        out = np.asarray(img.data)
+        return out[None] if self.vol.planar else out
+
+    def start(self) -> np.ndarray:
+        """The residual image to begin with, checked against the image given."""
+        img = self.image(self.res)
+        scale = float(np.max(np.abs(self.vol.data))) or 1.0
+        err = float(np.max(np.abs(img - self.vol.data))) / scale
+        if not err < 1e-5:
+            raise ValueError("image is not migrate(hologram, image.z, medium=medium, "
+                             f"upsample={self.options['upsample']}) (they differ by {err:.2g} of "
+                             "the peak); pass the migration's other options as "
+                             "migrate_options={...}, or leave hologram out")
+        return self.vol.data.copy()
+
+    # ----------------------------------------------------------------- the fit
+    def _eps_at(self, z: float) -> float:
+        m = self.pr_medium
+        return float(np.real(m.eps[int(m.region_of(z))]))
+
+    def response(self, r: np.ndarray) -> np.ndarray:
+        """``g`` at the elements (nf, N) for a unit point at ``r = (x, y, z)``."""
+        return self.pr.response(self._eps_at(float(r[2])), float(r[2]), (float(r[0]),
+                                                                         float(r[1])))
+
+    def focus(self, r: np.ndarray, h: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+        """``F``, the fitted amplitude(s) and ``g`` at ``r`` against hologram data ``h``."""
+        g = self.response(r)
+        c = np.einsum("fe,fe->f", g.conj(), h)
+        n = np.einsum("fe,fe->f", g.conj(), g).real
+        if self.pr.coherent:
+            a = np.full(len(c), c.sum() / n.sum())
+            F = abs(c.sum()) ** 2 / n.sum()
+        else:
+            a = c / n
+            F = float(np.sum(np.abs(c) ** 2 / n))
+        return float(F), a, g
+
+    def fit_position(self, start: tuple[float, float, float], h: np.ndarray,
+                     cell: tuple[float, float]) -> np.ndarray:
+        """The maximum of ``F`` near ``start`` (Nelder-Mead)."""
+        lo = self.z_min + 1e-4
+        x0 = np.array([start[0], start[1], max(start[2], lo + 1e-3)])
+        steps = np.array([cell[0] / 4, cell[1] / 4, max(cell[0], cell[1]) / 2])
+
+        def cost(v: np.ndarray) -> float:
+            if v[2] <= lo:
+                return 1e3 + (lo - v[2])
+            return -self.focus(v, h)[0] / self.energy(h)
+
+        simplex = np.vstack([x0] + [x0 + np.diag(steps)[i] for i in range(3)])
+        res = minimize(cost, x0, method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "xatol": 1e-5, "fatol": 1e-9,
+                                "maxiter": 400})
+        return np.asarray(res.x, float)
+
+    @staticmethod
+    def energy(h: np.ndarray) -> float:
+        return float(np.vdot(h, h).real) or 1.0
+
+    def fit(self, R: np.ndarray, index: tuple[int, int, int],
+            peak: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+        """Fit one object near the image peak, subtract it from the residual hologram.
+
+        Returns the object's image ``migrate(a g)``, its main lobe (the pixels of its
+        peak plane within 6 dB of its maximum) and ``{"position": ...}``.
+        """
+        cell = self._cell(peak[2])
+        r = self.fit_position(peak, self.res, cell)
+        _, a, g = self.focus(r, self.res)
+        m = a[:, None] * g
+        self.res = self.res - m
+        self.objects.append({"r": r, "a": a, "g": g})
+        img = self.image(m)
+        return img, self._lobe(img, index[0]), {"position": tuple(float(v) for v in r),
+                                                "object": len(self.objects) - 1}
+
+    def _cell(self, z: float) -> tuple[float, float]:
+        """Lateral resolution lambda L / A at range z (the starting simplex's scale)."""
+        lam = 2 * np.pi / float(self.pr.ks.max())
+        L = self.pr_medium.apparent_distance(max(z, self.z_min))
+        A, B = self.hologram.aperture_size
+        return lam * L / A, lam * L / B
+
+    @staticmethod
+    def _lobe(img: np.ndarray, iz: int) -> np.ndarray:
+        a = np.abs(img)
+        jz = int(np.unravel_index(int(np.argmax(a)), a.shape)[0])
+        plane = a[jz] if abs(jz - iz) > 0 else a[iz]
+        return plane >= 0.5 * plane.max()
+
+    # ------------------------------------------------------------ refinement
+    def refine(self) -> None:
+        """Refit every object's position on the hologram less all the others."""
+        for i, ob in enumerate(self.objects):
+            h_i = self.res + ob["a"][:, None] * ob["g"]
+            r = self.fit_position(tuple(ob["r"]), h_i, self._cell(float(ob["r"][2])))
+            _, a, g = self.focus(r, h_i)
+            self.res = h_i - a[:, None] * g
+            self.objects[i] = {"r": r, "a": a, "g": g}
+
+    def uncertainty(self) -> list[np.ndarray]:
+        """Standard deviations (x, y, z) of every object's position, metres (Cramer-Rao)."""
+        n = self.res.size
+        k = 4 * len(self.objects) * (1 if self.pr.coherent else self.res.shape[0])
+        s2 = float(np.vdot(self.res, self.res).real) / max(n - k, 1)
+        out = []
+        for ob in self.objects:
+            r, a, g = ob["r"], ob["a"], ob["g"]
+            step = 1e-4
+            D = []
+            for j in range(3):
+                e = np.zeros(3)
+                e[j] = step
+                D.append(((self.response(r + e) - self.response(r - e)) / (2 * step)).ravel())
+            D = np.array(D).T * np.repeat(a, g.shape[1])[:, None]       # (nf N, 3)
+            m = (a[:, None] * g).ravel()
+            D = D - np.outer(m, m.conj() @ D) / np.vdot(m, m).real      # orthogonal to m
+            J = 2 / s2 * (D.conj().T @ D).real
+            try:
+                cov = np.linalg.inv(J)
+                out.append(np.sqrt(np.maximum(np.diag(cov), 0)))
+            except np.linalg.LinAlgError:
+                out.append(np.full(3, np.nan))
+        return out

@@ -1,0 +1,81 @@
+"""The objects' table: columns, depths and their intervals."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["COLUMNS", "as_eps_interval", "depth_interval"]
+
+COLUMNS = ["kind", "x", "y", "range", "depth", "depth_low", "depth_high", "length", "width",
+           "azimuth_deg", "amplitude_db", "snr_db", "x_std", "y_std", "range_std",
+           "x_start", "y_start", "x_end", "y_end", "spacing", "model_error_db"]
+"""Columns of :func:`holoradar.detect`'s table, in order."""
+
+Z95 = 1.959963984540054  # two-sided 95 % of a normal distribution
+
+
+def as_eps_interval(eps_interval: Any) -> tuple[float, float] | None:
+    """``(low, high)`` real permittivities from a pair or an ``AutofocusResult``.
+
+    Raises
+    ------
+    ValueError
+        Not two finite numbers >= 1 with low <= high.
+
+    Examples
+    --------
+    >>> as_eps_interval((4.5, 3.5))
+    Traceback (most recent call last):
+    ...
+    ValueError: eps_interval must be (low, high) with low <= high, got (4.5, 3.5)
+    """
+    if eps_interval is None:
+        return None
+    if hasattr(eps_interval, "eps_interval") and not isinstance(eps_interval, tuple | list):
+        value = eps_interval.eps_interval
+        if value is None:
+            raise ValueError("eps_interval: the AutofocusResult has no interval "
+                             f"({getattr(eps_interval, 'reason', 'not determinable')})")
+        eps_interval = value
+    try:
+        lo, hi = (float(np.real(complex(v))) for v in eps_interval)
+    except (TypeError, ValueError):
+        raise ValueError("eps_interval must be (low, high): two real relative permittivities "
+                         f">= 1 (or an AutofocusResult), got {eps_interval!r}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 1:
+        raise ValueError("eps_interval must be (low, high): two finite relative permittivities "
+                         f">= 1, got {eps_interval!r}")
+    if lo > hi:
+        raise ValueError("eps_interval must be (low, high) with low <= high, got "
+                         f"{eps_interval!r}")
+    return lo, hi
+
+
+def depth_interval(depth: float, range_std: float, eps: float,
+                   eps_interval: tuple[float, float] | None, wideband: bool
+                   ) -> tuple[float, float]:
+    """Depth bounds: the range's 95 % interval, widened by the permittivity's.
+
+    An image focused through a ground of real permittivity ``eps`` puts a point at
+    depth ``d``. With another ``eps'`` the same data put it elsewhere: at one
+    frequency the wave front's curvature fixes the apparent depth ``d/n``
+    (paraxial), so ``d' = d sqrt(eps'/eps)``; across a band the two-way delay
+    fixes ``n d``, so ``d' = d sqrt(eps/eps')``. The bounds are the extremes over
+    the interval's ends, each widened by ``1.96`` range standard deviations.
+
+    Examples
+    --------
+    >>> [round(v, 4) for v in depth_interval(0.10, 0.0, 4.0, (3.0, 5.0), False)]
+    [0.0866, 0.1118]
+    >>> [round(v, 4) for v in depth_interval(0.10, 0.0, 4.0, (3.0, 5.0), True)]
+    [0.0894, 0.1155]
+    """
+    s = Z95 * range_std if np.isfinite(range_std) else 0.0
+    ends = [depth]
+    if eps_interval is not None and eps > 0:
+        for e in eps_interval:
+            f = np.sqrt(eps / e) if wideband else np.sqrt(e / eps)
+            ends.append(depth * f)
+    return float(min(ends) - s), float(max(ends) + s)
