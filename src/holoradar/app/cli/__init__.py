@@ -92,9 +92,10 @@ def main() -> None:
 
 
 def _register() -> None:
-    from . import batch, calibrate, focus, image, info, misc, plot, process, simulate, view
+    from . import batch, calibrate, detect, focus, image, info, misc, plot, process, simulate, view
 
-    for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch, view):
+    for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch, detect,
+                   view):
         for cmd in module.COMMANDS:
             main.add_command(cmd)
 

@@ -1,0 +1,220 @@
+"""``holoradar detect``: each output format parses back to ``hr.detect``'s table; outputs are
+never replaced unasked; bad options are one line naming the option, nothing written."""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+import holoradar as hr
+from holoradar.app.cli import main
+from holoradar.app.cli.detect import geojson
+
+warnings.filterwarnings("ignore", category=hr.AliasingWarning)
+pytestmark = pytest.mark.filterwarnings("ignore::holoradar.AliasingWarning")
+
+SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+GROUND = ["--eps", "2.5+0.0125j", "--z-surface", "0.3"]
+
+
+def run(*args: object, ok: bool = True) -> object:
+    res = CliRunner().invoke(main, [str(a) for a in args])
+    if ok:
+        assert res.exit_code == 0, res.output
+    return res
+
+
+def one_line_error(res: object, *needles: str) -> None:
+    assert res.exit_code == 2, res.output
+    errors = [ln for ln in res.output.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and "Traceback" not in res.output, res.output
+    for n in needles:
+        assert n in errors[0], errors[0]
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """Two points 20 dB apart, 12 cm deep in sand, under the paper's array; its hologram,
+    its image (with the history ``holoradar image`` writes, which records the ground) and
+    the reference table ``hr.detect`` gives."""
+    d = tmp_path_factory.mktemp("detect")
+    scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((-0.06, 0.03, 0.42), 1.0),
+                                            hr.PointTarget((0.08, -0.05, 0.42), 0.1)])
+    h = hr.simulate(scene, hr.Aperture.paper(), 9.9e9, include_surface=False, snr_db=40,
+                    seed=3)
+    holo = hr.save(h, d / "holo.nc")
+    step = {"step": "migrate", "input": "holo.nc", "parameters": {
+        "z": "0.42", "method": "angular", "frame": "aperture", "upsample": 4, "layout": None,
+        "medium": {"z_interfaces": [0.3], "eps": ["(1+0j)", "(2.5+0.0125j)"]}}}
+    hr.save(hr.migrate(h, 0.42, medium=SAND, upsample=4), d / "img.nc", history=[step])
+    img = hr.load(d / "img.nc")
+    ref = hr.detect(img, hologram=h, medium=SAND)
+    assert len(ref) == 2
+    return {"dir": d, "holo": holo, "img": d / "img.nc", "h": h, "ref": ref}
+
+
+def _same(table: pd.DataFrame, ref: pd.DataFrame) -> None:
+    pd.testing.assert_frame_equal(table.reset_index(drop=True), ref.reset_index(drop=True),
+                                  check_dtype=False, rtol=1e-12, atol=0)
+
+
+def _from_records(records: list[dict]) -> pd.DataFrame:
+    return pd.DataFrame(records).fillna(np.nan).infer_objects()
+
+
+def test_csv_is_detects_table(files):
+    out = files["dir"] / "objects.csv"
+    res = run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force")
+    _same(pd.read_csv(out), files["ref"])
+    # The terminal: one line per object (kind, x, y, depth with its interval, amp, SNR).
+    rows = [ln for ln in res.output.splitlines() if ln.strip().startswith(("1 ", "2 "))]
+    assert len(rows) == 2 and all("point" in r for r in rows)
+    assert "-6.0" in rows[0] and "12.0 [" in rows[0]
+    assert "ground from img.nc's history" in res.output
+
+
+def test_json_holds_the_records_and_the_metadata(files):
+    out = files["dir"] / "objects.json"
+    run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force")
+    doc = json.loads(out.read_text())
+    _same(_from_records(doc["objects"])[files["ref"].columns], files["ref"])
+    meta = doc["metadata"]
+    assert meta["threshold"] == pytest.approx(files["ref"].attrs["threshold"])
+    assert meta["n_cells"] == pytest.approx(files["ref"].attrs["n_cells"])
+    assert meta["model"] == "hologram" and meta["source"] == str(files["img"])
+    assert meta["medium"]["z_interfaces_m"] == [0.3]
+    assert meta["eps_interval"] is None and meta["false_alarm"] == 1e-3
+
+
+def test_geojson_is_a_feature_collection_in_local_metres(files):
+    out = files["dir"] / "objects.geojson"
+    run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force", "-q")
+    doc = json.loads(out.read_text())
+    assert doc["type"] == "FeatureCollection" and "crs" not in doc
+    assert doc["coordinate_frame"]["units"] == "m"
+    feats = doc["features"]
+    assert [f["geometry"]["type"] for f in feats] == ["Point", "Point"]
+    _same(_from_records([f["properties"] for f in feats])[files["ref"].columns], files["ref"])
+    for f, (_, row) in zip(feats, files["ref"].iterrows(), strict=True):
+        assert f["geometry"]["coordinates"] == pytest.approx([row.x, row.y], abs=1e-12)
+
+
+def test_geojson_lines_and_areas():
+    df = pd.DataFrame([
+        {"kind": "line", "x": 0.0, "y": 0.0, "x_start": -0.1, "y_start": 0.0, "x_end": 0.1,
+         "y_end": 0.0, "length": 0.2, "width": 0.0, "azimuth_deg": 0.0},
+        {"kind": "area", "x": 1.0, "y": 2.0, "x_start": np.nan, "y_start": np.nan,
+         "x_end": np.nan, "y_end": np.nan, "length": 0.4, "width": 0.2, "azimuth_deg": 90.0}])
+    line, area = geojson(df, {}, "scene")["features"]
+    assert line["geometry"] == {"type": "LineString", "coordinates": [[-0.1, 0.0], [0.1, 0.0]]}
+    ring = np.array(area["geometry"]["coordinates"][0])
+    assert area["geometry"]["type"] == "Polygon" and np.allclose(ring[0], ring[-1])
+    assert np.ptp(ring[:, 0]) == pytest.approx(0.2) and np.ptp(ring[:, 1]) == pytest.approx(0.4)
+    assert area["properties"]["x_start"] is None    # NaN is null: valid JSON
+
+
+def test_hologram_file_imaged_on_z_then_fitted(files):
+    res = run("detect", files["holo"], "--z", "0.42", *GROUND, "--eps-interval", "2.2,2.8",
+              "--json")
+    doc = json.loads(res.stdout)
+    img = hr.migrate(files["h"], 0.42, medium=SAND, upsample=4)
+    ref = hr.detect(img, hologram=files["h"], medium=SAND, eps_interval=(2.2, 2.8))
+    _same(_from_records(doc["objects"])[ref.columns], ref)
+    assert doc["n_objects"] == 2 and doc["metadata"]["eps_interval"] == [2.2, 2.8]
+    assert (ref.depth_high - ref.depth_low > 0.01).all()   # the eps interval widens it
+
+
+def test_quiet_keeps_the_table(files):
+    res = run("detect", files["img"], "--z", "0.42", "-q")
+    assert "point" in res.output and "object(s)" not in res.output
+
+
+def test_existing_output_refused_without_force(files):
+    out = files["dir"] / "keep.csv"
+    out.write_text("precious")
+    res = run("detect", files["img"], "-o", out, ok=False)
+    one_line_error(res, "--out", "--force")
+    assert out.read_text() == "precious"
+    run("detect", files["img"], "-o", out, "--force")
+    assert pd.read_csv(out).kind.tolist() == ["point", "point"]
+
+
+@pytest.mark.parametrize(("args", "needles"), [
+    (["--eps-interval", "2.5"], ["--eps-interval", "LO,HI"]),
+    (["--eps-interval", "2.8,2.2"], ["--eps-interval", "LO <= HI"]),
+    (["--eps-interval", "0.5,2"], ["--eps-interval", ">= 1"]),
+    (["--false-alarm", "0.5"], ["--false-alarm", "(0, 0.1]"]),
+    (["--false-alarm", "often"], ["--false-alarm"]),
+    (["--kinds", "point,blob"], ["--kinds", "point, line, area"]),
+    (["--eps", "2.5"], ["--eps/--z-surface"]),
+    (["--z", "0.3:0.5:0.01"], ["--z", "one range"]),
+    (["--z", "0.9"], ["--z"]),
+    (["--z", "0.42", "--hologram", "HOLO"], ["--z", "not both"]),
+])
+def test_bad_options_named_nothing_written(files, args, needles):
+    out = files["dir"] / "never.json"
+    args = [str(files["holo"]) if a == "HOLO" else a for a in args]
+    one_line_error(run("detect", files["img"], *args, "-o", out, ok=False), *needles)
+    assert not out.exists()
+
+
+def test_bad_inputs_named(files, tmp_path):
+    # A hologram needs its planes; an output that is not a table's suffix; a volume needs
+    # its hologram or one plane; an eps interval needs a ground.
+    one_line_error(run("detect", files["holo"], ok=False), "--z")
+    one_line_error(run("detect", files["img"], "-o", tmp_path / "o.txt", ok=False), "--out",
+                   ".csv")
+    vol = hr.migrate(files["h"], np.array([0.41, 0.42, 0.43]), medium=SAND, upsample=4)
+    hr.save(vol, tmp_path / "vol.nc")
+    one_line_error(run("detect", tmp_path / "vol.nc", ok=False), "FILE", "--hologram", "--z")
+    one_line_error(run("detect", files["holo"], "--z", "0.42", "--eps-interval", "2,3",
+                       ok=False), "--eps-interval", "ground")
+    # The wrong hologram for an image: refused by the option's name.
+    other = hr.save(hr.Hologram(files["h"].data[::-1], files["h"].x, files["h"].y, 9.9e9),
+                    tmp_path / "other.nc")
+    one_line_error(run("detect", files["img"], "--hologram", other, ok=False), "--hologram")
+    assert not list(tmp_path.glob("*.csv")) and not list(tmp_path.glob("*.json"))
+
+
+@pytest.fixture(scope="module")
+def survey(tmp_path_factory):
+    """Two overlapping frames (16 x 16 at 1.25 cm, 10 cm apart along x, at y = 0.1 m) over
+    one point 12 cm deep in sand at world (0.04, 0.11)."""
+    d = tmp_path_factory.mktemp("survey")
+    scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.04, 0.11, 0.42))])
+    paths = []
+    for i, x0 in enumerate((0.0, 0.1)):
+        ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((x0, 0.1, 0.0)))
+        h = hr.simulate(scene, ap, 9.9e9, include_surface=False, snr_db=40, seed=i)
+        paths.append(hr.save(h, d / f"frame{i}.nc"))
+    hr.survey.run_batch(paths, d / "s.zarr", z=[0.42], medium=SAND, upsample=4,
+                        scheduler="synchronous")
+    return d
+
+
+@pytest.mark.parametrize("plane", [[], ["--z", "0.42"]])
+def test_survey_objects_in_survey_coordinates_once(survey, plane):
+    out = survey / f"objects{len(plane)}.geojson"
+    run("detect", survey / "s.zarr", *plane, "-o", out, "--force")
+    doc = json.loads(out.read_text())
+    feats = doc["features"]
+    assert len(feats) == 1, [f["properties"] for f in feats]   # seen by both frames: once
+    p = feats[0]["properties"]
+    cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, SAND.apparent_distance(0.42), 0.2)
+    assert abs(p["x"] - 0.04) < cell / 4 and abs(p["y"] - 0.11) < cell / 4
+    assert feats[0]["geometry"]["coordinates"] == pytest.approx([p["x"], p["y"]])
+    assert p["frame"] == "frame0.nc"       # the frame it lies nearest the centre of
+    assert p["depth"] == pytest.approx(0.12, abs=0.01)
+    assert "survey" in doc["coordinate_frame"]["frame"]
+    assert [f["frame"] for f in doc["metadata"]["per_frame"]] == ["frame0.nc", "frame1.nc"]
+
+
+def test_survey_refuses_ground_flags_and_hologram(survey, files):
+    one_line_error(run("detect", survey / "s.zarr", *GROUND, ok=False), "--eps/--z-surface")
+    one_line_error(run("detect", survey / "s.zarr", "--hologram", files["holo"], ok=False),
+                   "--hologram")
