@@ -311,8 +311,42 @@ class Image:
         """``|data|^2``."""
         return np.abs(self.data) ** 2
 
-    def peak(self) -> tuple[float, float, float]:
-        """``(x, y, z)`` of the brightest pixel, metres (over all planes)."""
+    def peak(self, unbiased: bool = False, *, hologram: Any = None, medium: Any = None,
+             migrate_options: Any = None) -> tuple[float, float, float]:
+        """Where the brightest object is, metres.
+
+        Parameters
+        ----------
+        unbiased : bool
+            False (default): ``(x, y, z)`` of the brightest pixel over all planes.
+            True: the position of the object that makes it, by the point-response
+            fit :func:`holoradar.detect` uses (the maximum of the normalised
+            matched filter on ``hologram``): no pull towards the array along the
+            line of sight, range fitted even from one plane; the result also
+            carries ``.std`` (standard deviations, metres). See
+            :func:`holoradar.analysis.detect.peak.unbiased_peak`.
+        hologram : Hologram
+            With ``unbiased``: the hologram the image was migrated from (one frame,
+            a level array at z = 0; a tilted array is refused).
+        medium : Medium, optional
+            With ``unbiased``: the ground the image was formed through.
+        migrate_options : mapping, optional
+            With ``unbiased``: ``migrate``'s other arguments the image was made with.
+
+        Returns
+        -------
+        tuple of float
+            ``(x, y, z)``; with ``unbiased`` a
+            :class:`~holoradar.analysis.detect.peak.PeakPosition` (a 3-tuple with
+            ``.std``).
+        """
+        if unbiased:
+            from ..analysis.detect.peak import unbiased_peak
+
+            return unbiased_peak(self, hologram, medium, migrate_options)
+        if hologram is not None or medium is not None or migrate_options is not None:
+            raise ValueError("peak(): hologram=, medium= and migrate_options= are for "
+                             "unbiased=True")
         a = np.abs(self.data)
         if not self.has_z_axis:
             a = a[..., None, :, :]

@@ -1,0 +1,127 @@
+"""The brightest object where it is, not where its image peaks: ``Image.peak(unbiased=True)``.
+
+The image's amplitude maximum is biased along the line of sight: at one
+frequency the focus is tens of centimetres long and the adjoint's ``1/r``
+weighting pulls its maximum towards the array (a point 10 cm deep in sand
+under a level 32 x 32 array 50 cm above the sand images brightest 9 cm short
+of it). :func:`unbiased_peak` fits the exact point response to the hologram the
+image came from, starting at the image's brightest pixel: the fit
+:func:`~holoradar.detect` uses (:class:`~.model.HologramModel`, the maximum of
+the normalised matched filter), with its Cramer-Rao standard deviations.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .grid import as_volume, refine_peak
+
+__all__ = ["PeakPosition", "unbiased_peak"]
+
+
+class PeakPosition(tuple):
+    """``(x, y, z)`` in metres, with the fit's standard deviations and amplitude.
+
+    A plain 3-tuple to unpack (``x, y, z = img.peak(unbiased=True, hologram=h)``)
+    that also carries:
+
+    Attributes
+    ----------
+    std : tuple of float
+        Standard deviations of x, y, z, metres (Cramer-Rao bound of the fit, the
+        noise per element estimated from what the fitted point leaves of the
+        hologram: everything else in it counts as noise, so it is conservative
+        when the hologram holds further objects).
+    amplitude : complex
+        The fitted scattering amplitude (the first frequency's, for a band).
+    focus_fraction : float
+        The share of the hologram's energy the fitted point explains (0..1).
+
+    Examples
+    --------
+    >>> p = PeakPosition((0.01, 0.0, 0.6), (1e-4, 1e-4, 5e-4), 1 + 0j, 0.9)
+    >>> x, y, z = p
+    >>> z, p.std[2]
+    (0.6, 0.0005)
+    """
+
+    std: tuple[float, float, float]
+    amplitude: complex
+    focus_fraction: float
+
+    def __new__(cls, xyz: Any, std: Any, amplitude: complex = 0j,
+                focus_fraction: float = np.nan) -> PeakPosition:
+        obj = super().__new__(cls, tuple(float(v) for v in xyz))
+        obj.std = tuple(float(v) for v in std)  # type: ignore[assignment]
+        obj.amplitude = complex(amplitude)
+        obj.focus_fraction = float(focus_fraction)
+        return obj
+
+    def __repr__(self) -> str:
+        x, y, z = self
+        sx, sy, sz = self.std
+        return (f"PeakPosition(x={x:.5g} +- {sx:.2g}, y={y:.5g} +- {sy:.2g}, "
+                f"z={z:.5g} +- {sz:.2g} m)")
+
+
+def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
+                  migrate_options: Mapping[str, Any] | None = None) -> PeakPosition:
+    """The position of the image's brightest object by the point-response fit.
+
+    Parameters
+    ----------
+    image : Image
+        One frame: a plane or a volume, ``migrate(hologram, z, medium=medium,
+        upsample=u, **migrate_options)``.
+    hologram : Hologram
+        The hologram the image was migrated from (one frame, a level array at
+        z = 0 with the identity pose).
+    medium : Medium, optional
+        The ground the image was formed through (None: free space).
+    migrate_options : mapping, optional
+        ``migrate``'s other keyword arguments the image was made with
+        (``method``, ``dtype``...).
+
+    Returns
+    -------
+    PeakPosition
+        ``(x, y, z)`` metres, with ``.std``. Even from one plane the range ``z``
+        is the fit's (the hologram's wave front fixes it), not the plane's.
+
+    Raises
+    ------
+    ValueError
+        No hologram, a hologram that did not make the image, a tilted or moved
+        array (the fit's point response is tabulated for a level aperture at
+        z = 0 only), several frames.
+    """
+    if hologram is None:
+        raise ValueError("peak(unbiased=True) needs hologram= (the hologram the image was "
+                         "migrated from): the fit of the point response is made on it")
+    from .model import HologramModel
+
+    vol = as_volume(image)
+    model = HologramModel(hologram, vol, medium, dict(migrate_options or {}))
+    # The image only gives the fit its start: a loose check that it is this hologram's
+    # (a plane cut from a volume differs from the plane's own migration by ~2 % through
+    # a lossy ground, where the loss compensation depends on the planes).
+    scale = float(np.max(np.abs(vol.data))) or 1.0
+    err = float(np.max(np.abs(model.image(model.res) - vol.data))) / scale
+    if not err < 0.1:
+        raise ValueError(f"image is not the migration of hologram (through medium, with "
+                         f"upsample={model.options['upsample']}): they differ by {err:.2g} of "
+                         "the peak; pass the hologram it was made from (and migrate_options= "
+                         "for other settings such as method)")
+    p = np.abs(vol.data) ** 2
+    index = tuple(int(i) for i in np.unravel_index(int(np.argmax(p)), p.shape))
+    frac, _ = refine_peak(p, index)  # type: ignore[arg-type]
+    start = vol.coords(*frac)
+    r = model.fit_position(start, model.res, model._cell(start[2]))
+    F, a, g = model.focus(r, model.res)
+    model.res = model.res - a[:, None] * g
+    model.objects.append({"r": r, "a": a, "g": g})
+    std = model.uncertainty()[0]
+    return PeakPosition(r, std, complex(a[0]), F / model.energy(model.h))
