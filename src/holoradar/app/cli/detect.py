@@ -365,8 +365,8 @@ def table_lines(df: Any) -> list[str]:
     ...        "depth_low": 0.11, "depth_high": 0.13, "range_std": 1e-3,
     ...        "amplitude_db": -20.0, "snr_db": 35.0, "length": 0.0, "azimuth_deg": float("nan")}
     >>> print("\\n".join(table_lines(pd.DataFrame([row]))))
-      #  kind     x cm    y cm  depth cm [95 %]         amp dB  SNR dB
-      1  point    10.0    -2.0  12.0 [11.0, 13.0]        -20.0    35.0
+      #  kind      x cm    y cm  depth cm [95 %]         amp dB  SNR dB
+      1  point     10.0    -2.0  12.0 [11.0, 13.0]        -20.0    35.0
     """
     depth = "depth" in df and bool(np.isfinite(df["depth"]).any())
     head = "depth cm [95 %]" if depth else "range cm +- std"
