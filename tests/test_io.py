@@ -183,6 +183,24 @@ def test_file_is_plain_netcdf_with_cf_units(tmp_path):
     assert steps[-1]["step"] == "save" and steps[-1]["holoradar"] == hr.__version__
 
 
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_a_real_image_is_stored_real(tmp_path, dtype):
+    """An amplitude map (a survey's mosaic) is its values, not I and Q = 0 read back as
+    complex at twice the size; both readers give it back real and equal."""
+    import xarray as xr
+
+    amp = np.random.default_rng(3).random((2, 3, 4)).astype(dtype)
+    img = hr.Image(amp, np.arange(4.0), np.arange(3.0), np.array([0.3, 0.4]), 9.9e9, "mosaic")
+    path = hr.save(img, tmp_path / "m.nc")
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        assert ds["image"].dims == ("z", "y", "x") and ds["image"].dtype == dtype
+        assert "iq" not in ds.variables
+        back = from_dataset(ds)
+    for got in (back, hr.load(path), read_direct(path)):
+        assert got.data.dtype == dtype and np.array_equal(got.data, amp)
+        assert got.method == "mosaic" and got.has_z_axis
+
+
 def test_history_is_kept(tmp_path):
     steps = [{"step": "migrate", "parameters": {"z": 0.4}}]
     path = hr.save(IMAGES["plane"], tmp_path / "i.nc", history=steps)

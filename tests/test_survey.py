@@ -180,8 +180,13 @@ def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
 
     monkeypatch.setattr(survey_worker, "write_frame", crash_after_image)
     store = tmp_path / "s.zarr"
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(KeyboardInterrupt) as stop:
         hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
+    # Ctrl-C says what the store holds (the command line prints it as its one line)
+    assert isinstance(stop.value, hr.survey.BatchInterrupted)
+    assert (stop.value.stored, stop.value.frames) == (5, 12)
+    assert str(stop.value) == (f"interrupted: 5 of 12 frames are stored in {str(store)!r}; "
+                               "run_batch with the same arguments resumes")
     ds = hr.survey.open_survey(store)
     assert int(ds["done"].sum()) == 5 and not bool(ds["done"][crashed[0]])
     assert _assert_exact(store, paths, holos).sum() == 5
@@ -189,6 +194,35 @@ def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
     s = hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
     assert (s["resumed"], s["done"]) == (5, 7)
     assert _assert_exact(store, paths, holos).all()
+
+
+def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """After Ctrl-C the caller asks the workers to stop (schedule.stop_requested): a task
+    finishes the frame in hand and starts no other; the next run starts afresh."""
+    from holoradar.survey import schedule
+
+    paths, holos = survey200
+    real = survey_worker.process_frame
+    calls = []
+
+    def ctrl_c_during_the_first(*args, **kwargs):
+        calls.append(1)
+        schedule._LOCAL_STOP.set()  # what run_tasks does on KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(survey_worker, "process_frame", ctrl_c_during_the_first)
+    store = tmp_path / "s.zarr"
+    job = survey_worker.Job(str(store), "run", hr.survey.Settings.make(Z, None, "angular", 1),
+                            hr.survey.FrameGeometry.of(holos[0]), False)
+    survey_store.create_store(store, job.settings, job.geometry)
+    slots = survey_store.register_frames(store, [p.resolve() for p in paths[:4]])
+    chunk = [(slot, str(p), p.name) for slot, p in zip(slots, paths[:4], strict=True)]
+    assert [r["status"] for r in survey_worker.process_chunk(chunk, job)] == ["done"]
+    assert len(calls) == 1
+    monkeypatch.setattr(survey_worker, "process_frame", real)
+    s = hr.survey.run_batch(paths[:4], store, z=Z, scheduler="synchronous")
+    assert (s["resumed"], s["done"]) == (1, 3)  # the stop does not outlive its run
 
 
 def test_killed_process_leaves_readable_store(survey200, tmp_path: Path) -> None:
@@ -223,6 +257,76 @@ def test_killed_process_leaves_readable_store(survey200, tmp_path: Path) -> None
     s = hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
     assert (s["resumed"], s["done"]) == (done_before, len(frames) - done_before)
     assert _assert_exact(store, paths, holos).all()
+
+
+def test_images_are_compressed_and_plain_stores_still_work(survey200, tmp_path: Path,
+                                                            monkeypatch: pytest.MonkeyPatch
+                                                            ) -> None:
+    """New stores compress the images (Blosc LZ4, shuffled); a store written before
+    (plain chunks) is read and resumed as it is, exactly."""
+    import zarr
+
+    paths, holos = survey200
+    new = tmp_path / "new.zarr"
+    hr.survey.run_batch(paths[:3], new, z=Z, scheduler="synchronous")
+    codecs = zarr.open_array(str(new / "image"), mode="r").compressors
+    assert [(type(c).__name__, c.cname.value, c.shuffle.value) for c in codecs] == \
+        [("BloscCodec", "lz4", "shuffle")]
+    assert hr.survey.describe_store(new)["compressors"] == ["blosc"]
+    assert _assert_exact(new, paths, holos).all()
+
+    old = tmp_path / "old.zarr"
+    monkeypatch.setattr(survey_store, "_image_codecs", lambda: None)  # as stores were made
+    hr.survey.run_batch(paths[:3], old, z=Z, scheduler="synchronous")
+    monkeypatch.undo()
+    assert zarr.open_array(str(old / "image"), mode="r").compressors == ()
+    s = hr.survey.run_batch(paths[:6], old, z=Z, scheduler="synchronous")
+    assert (s["resumed"], s["done"]) == (3, 3)
+    assert _assert_exact(old, paths, holos).all()
+    assert hr.survey.describe_store(old)["compressors"] == []
+    np.testing.assert_array_equal(hr.survey.frame_image(old, 4).data,
+                                  hr.migrate(holos[4], Z).data)
+
+
+def test_size_is_said_before_and_a_full_disk_refused(survey200, tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    import shutil as sh
+
+    from holoradar.survey import batch as survey_batch
+
+    paths, _ = survey200
+    per = 2 * 8 * 8 * 2 * 8  # 2 planes of 8 x 8 pixels, I and Q as float64
+    plans = []
+    store = tmp_path / "s.zarr"
+    s = hr.survey.run_batch(paths[:4], store, z=Z, scheduler="synchronous", on_start=plans.append)
+    assert len(plans) == 1 and plans[0]["frames"] == 4
+    assert (plans[0]["bytes"], plans[0]["bytes_per_frame"], s["bytes_estimated"]) == \
+        (4 * per, per, 4 * per)
+    assert plans[0]["image_shape"] == [2, 8, 8] and plans[0]["dtype"] == "float64"
+    s = hr.survey.run_batch(paths[:6], store, z=Z, scheduler="synchronous",
+                            on_start=plans.append)  # a rerun counts what is left
+    assert plans[1]["frames"] == 2 and s["bytes_estimated"] == 2 * per
+    hr.survey.run_batch(paths[:6], store, z=Z, scheduler="synchronous", on_start=plans.append)
+    assert len(plans) == 2  # nothing left to image: no plan
+
+    real = sh.disk_usage
+
+    def tiny(path):
+        return real(path)._replace(free=3 * per)
+
+    monkeypatch.setattr(survey_batch.shutil, "disk_usage", tiny)
+    with pytest.raises(ValueError, match=r"would need up to 10 kB for 5 frames \(2.05 kB "
+                       r"each: 2 planes of 8 x 8 pixels, I and Q as float64\) but its disk "
+                       r"has 6.14 kB free: free some space"):
+        hr.survey.run_batch(paths[:5], tmp_path / "t.zarr", z=Z, scheduler="synchronous")
+    assert not (tmp_path / "t.zarr").exists()  # refused before anything was written
+    with pytest.raises(ValueError, match=r"would need up to 14 kB for 7 frames"):
+        hr.survey.run_batch(paths[:13], store, z=Z, scheduler="synchronous")
+    assert survey_store.read_index(store)["done"].sum() == 6  # the store kept as it was
+    # A store replaced (overwrite=True) frees its own space: 6 frames' worth, so 9 fit.
+    s = hr.survey.run_batch(paths[:9], store, z=[0.05, 0.2], scheduler="synchronous",
+                            overwrite=True)
+    assert s["done"] == 9
 
 
 # (e) the mosaic puts a point target at its world position

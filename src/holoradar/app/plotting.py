@@ -274,7 +274,8 @@ def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = Non
                                                "the surface"
         ax.set_title(f"range z = {z * CM:.1f} cm{depth}", fontsize=9)
         if not shared or ax is axes[-1]:
-            fig.colorbar(m, ax=ax, label=label + (" (all panels)" if shared else ""))
+            fig.colorbar(m, ax=ax, label=label + (" (all panels)" if shared and len(panels) > 1
+                                                  else ""))
     if title:
         fig.suptitle(title)
     return fig

@@ -5,7 +5,9 @@ Layout of a file:
 * one data variable, ``hologram`` or ``image``, real, with a last dimension
   ``iq`` of size 2: index 0 the in-phase part I, index 1 the quadrature Q, the
   complex sample being ``I + iQ`` (time dependence ``exp(-i omega t)``); no
-  complex type is needed to read it;
+  complex type is needed to read it. An image whose values are real (an
+  amplitude map such as a survey's mosaic) is stored as they are, float64 or
+  float32, without the ``iq`` dimension, and read back real;
 * its other dimensions: leading frames ``frame0``, ``frame1``, ... , then
   ``frequency`` (a wideband hologram), ``z`` (an image with planes), ``y``, ``x``;
 * coordinates in metres and hertz with CF ``units`` and ``long_name``: ``x``,
@@ -204,8 +206,16 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
                   "time": now})
     attrs["holoradar_kind"] = kind
     attrs["history"] = json.dumps(steps)
-    values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
-                         {"long_name": long_name, "units": "1"})
+    if kind == "Image" and not np.iscomplexobj(data):
+        # A real image (an amplitude map): its values as they are, not I and Q = 0 at
+        # twice the size read back as complex.
+        del coords["iq"], attrs["iq_convention"]
+        values = xr.Variable((*lead, *core), data.astype(
+            np.float32 if data.dtype == np.float32 else np.float64, copy=False),
+            {"long_name": f"{long_name} (real values)", "units": "1"})
+    else:
+        values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
+                             {"long_name": long_name, "units": "1"})
     return xr.Dataset({var: values}, coords=coords, attrs=attrs)
 
 
@@ -242,15 +252,19 @@ def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
     var = kind.lower()
     _need(ds, [var, "x", "y", "frequency"], what)
     arr = ds[var]
-    if arr.dims[-1] != "iq" or arr.shape[-1] != 2:
+    real = kind == "Image" and "iq" not in arr.dims  # a real image (an amplitude map)
+    if not real and (arr.dims[-1] != "iq" or arr.shape[-1] != 2):
         raise ValueError(f"{what}: variable {var!r} must end in a dimension 'iq' of size 2 "
                          f"(I, Q), got dims {arr.dims} and shape {arr.shape}")
     raw = np.asarray(arr.values)
     if not np.issubdtype(raw.dtype, np.floating):
         raise ValueError(f"{what}: variable {var!r} must be real numbers, got {raw.dtype}")
-    data = raw[..., 0] + 1j * raw[..., 1]
-    if raw.dtype == np.float32:
-        data = data.astype(np.complex64)
+    if real:
+        data = raw.astype(np.float32 if raw.dtype == np.float32 else np.float64, copy=False)
+    else:
+        data = raw[..., 0] + 1j * raw[..., 1]
+        if raw.dtype == np.float32:
+            data = data.astype(np.complex64)
     x, y = np.asarray(ds["x"].values, float), np.asarray(ds["y"].values, float)
     f = np.asarray(ds["frequency"].values, float).ravel()
     wideband = bool(int(ds.attrs.get("wideband", f.size > 1)))

@@ -313,6 +313,27 @@ def is_number(text: str) -> bool:
     return True
 
 
+def _shorten(text: str, width: int) -> str:
+    """``text`` on one line, at most ``width`` characters: cut at a word boundary and
+    marked `` ...`` (a library's long message, kept readable).
+
+    Examples
+    --------
+    >>> _shorten("one two  three", 20), _shorten("one two three four", 14)
+    ('one two three', 'one two ...')
+    >>> _shorten("x" * 30, 12)
+    'xxxxxxxx ...'
+    """
+    text = " ".join(str(text).split())
+    if len(text) <= width:
+        return text
+    cut = text[:width - 4]
+    space = cut.rfind(" ")
+    if space >= len(cut) // 2:  # a word boundary not too far back; else one long word, cut
+        cut = cut[:space]
+    return cut.rstrip(" ,;:") + " ..."
+
+
 def read_netcdf_variables(path: Path) -> dict[str, np.ndarray]:
     """A NetCDF file not written by holoradar (NetCDF-4 or NetCDF-3): every numeric
     variable by name, CF-decoded (``scale_factor``, ``add_offset``, ``_FillValue`` applied,
@@ -326,7 +347,7 @@ def read_netcdf_variables(path: Path) -> dict[str, np.ndarray]:
         ds = xr.open_dataset(path, decode_times=False, decode_timedelta=False)
     except (ValueError, OSError, TypeError, KeyError) as exc:
         raise ValueError(f"{path.name} is not a readable NetCDF file "
-                         f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+                         f"({type(exc).__name__}: {_shorten(str(exc), 200)})") from None
     with ds:
         for name, var in ds.variables.items():
             if var.dtype.kind not in "biufc":

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import os
+import shutil
 import time
 import uuid
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -14,17 +15,68 @@ from ..physics.medium import Medium
 from . import schedule
 from .frames import FrameGeometry
 from .settings import Settings
-from .store import create_store, is_survey, read_index, register_frames, stored_settings
+from .store import (
+    create_store,
+    frame_bytes,
+    is_survey,
+    note_skipped,
+    read_index,
+    register_frames,
+    stored_settings,
+)
 from .worker import Job, process_chunk, read_frame
 
-__all__ = ["run_batch"]
+__all__ = ["BatchInterrupted", "SettingsMismatchError", "run_batch"]
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """:func:`run_batch` stopped by Ctrl-C (SIGINT): how much of the survey is stored.
+
+    A ``KeyboardInterrupt``, so code that stops on one still stops; raised once the
+    local workers have stopped (:func:`~holoradar.survey.schedule.run_tasks`). The
+    store is consistent: a rerun with the same arguments images the rest.
+
+    Attributes
+    ----------
+    store : str
+        The store's path.
+    stored : int
+        Frames of this run's list stored complete (done), before or during it.
+    frames : int
+        Distinct frames the run was given.
+    """
+
+    def __init__(self, store: str, stored: int, frames: int) -> None:
+        self.store, self.stored, self.frames = store, stored, frames
+        of = f"{frames} frame is" if frames == 1 else f"{frames} frames are"
+        super().__init__(f"interrupted: {stored} of {of} stored in {store!r}; run_batch "
+                         "with the same arguments resumes")
+
+
+class SettingsMismatchError(ValueError):
+    """An existing store was made with other settings than a run asks for.
+
+    Attributes
+    ----------
+    store : str
+        The store's path.
+    differences : list of str
+        One line per setting that differs (``"z: the store has ..., this run asks ..."``).
+    """
+
+    def __init__(self, store: str, differences: list[str]) -> None:
+        self.store, self.differences = store, list(differences)
+        super().__init__(f"store {store!r} was made with other settings ("
+                         + "; ".join(differences) + "): pass overwrite=True to start it "
+                         "again (its frames are removed), or choose another store")
 
 
 def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike[str], *,
               z: float | Sequence[float], medium: Medium | None = None,
               method: str = "angular", upsample: int = 1, scheduler: str | None = None,
               strict: bool = False, overwrite: bool = False,
-              progress: bool = False, layout: Any = None) -> dict[str, Any]:
+              progress: bool = False, layout: Any = None,
+              on_start: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     Each frame (a hologram file written by :func:`holoradar.save`) is read with
@@ -69,6 +121,12 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     layout : Layout, dict or str, optional
         For frames in a user's format: where the hologram is in each file
         (:func:`holoradar.load`); the same for every frame.
+    on_start : callable, optional
+        Called once before the first frame is imaged (not when none is left to
+        image) with the plan: ``frames`` (to image), ``bytes`` (the most the store
+        grows by: their images before compression), ``bytes_per_frame``,
+        ``image_shape`` (nz, ny', nx'), ``dtype`` (of the stored I and Q values),
+        ``free`` (bytes free on the store's disk) and ``store``.
 
     Returns
     -------
@@ -78,18 +136,32 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         "reason"}``), ``seconds`` (wall time of the run), ``frames`` (distinct
         frames asked), ``store`` (its path), ``scheduler``, ``workers`` and
         ``warnings`` (each distinct warning the workers raised, once, as
-        ``"Category: message"``).
+        ``"Category: message"``), ``bytes_estimated`` (the store's growth at most,
+        as given to ``on_start``; 0 when nothing was left to image).
 
     Raises
     ------
     ValueError
         No frames; a bad store path (suffix, folder, equal to a frame, an
         existing folder that is not a survey store); an existing store made
-        with other settings (unless ``overwrite``); a bad scheduler; no frame
-        can be imaged; with ``strict``, the first frame that cannot be imaged.
+        with other settings (unless ``overwrite``; :class:`SettingsMismatchError`); a
+        bad scheduler; no frame can be imaged; with ``strict``, the first frame
+        that cannot be imaged; the images would not fit on the store's disk
+        (checked before any is imaged, against their size before compression).
+    BatchInterrupted
+        Ctrl-C (a ``KeyboardInterrupt``): the workers are stopped, and the
+        exception says how many of the frames are stored.
 
     Notes
     -----
+    The store's images are compressed (Blosc LZ4 after a byte shuffle), which
+    saves only about a tenth: float images are noise in their low bits. Each
+    frame takes ``nz * ny' * nx' * 2 * 8`` bytes before compression (4 for
+    complex64 frames), ``ny' = upsample * (ny - 1) + 1``: 240 frames of 16 x 16
+    elements with 61 planes at ``upsample=8`` take up to 3.4 GB. Those not
+    imaged yet must fit in the free space of the store's disk, or the run is
+    refused before it starts.
+
     All frames must share the grid, pitch, frequencies, kind (array or
     transceiver) and aperture height of the first readable frame (of the store,
     when resuming); a frame that differs is skipped with the reason. Frames
@@ -135,12 +207,70 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     try:
         summary = _run(given, target, settings, sched, client, strict=bool(strict),
                        overwrite=overwrite, exists=exists, progress=progress,
-                       layout=_layout_text(layout))
+                       layout=_layout_text(layout), on_start=on_start)
+    except KeyboardInterrupt:
+        # The workers have stopped (run_tasks): what the store holds now is what a
+        # rerun finds. "from None": the interrupted frame's traceback says nothing.
+        raise _interrupted(target, given) from None
     finally:
         if client is not None:
             client.close()
     summary["seconds"] = time.perf_counter() - t0
     return summary
+
+
+def _interrupted(target: Path, given: list[Path]) -> BatchInterrupted:
+    """How many of the frames asked are stored complete, once a run is interrupted."""
+    asked = {str(p.resolve()) for p in given}
+    stored = 0
+    try:
+        if is_survey(target):
+            idx = read_index(target)
+            stored = sum(1 for p, d in zip(idx["frame_path"], idx["done"], strict=True)
+                         if d and p in asked)
+    except ValueError:  # a store damaged before this run: nothing of it counts
+        pass
+    return BatchInterrupted(str(target), stored, len(asked))
+
+
+def bytes_text(n: float) -> str:
+    """Bytes for a person: ``3.43 GB`` (powers of 1000).
+
+    Examples
+    --------
+    >>> bytes_text(3.43e9), bytes_text(468512), bytes_text(512)
+    ('3.43 GB', '469 kB', '512 bytes')
+    """
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}" if n < 10 * scale else f"{n / scale:.0f} {unit}"
+    return f"{int(n)} bytes"
+
+
+def _folder_bytes(path: Path) -> int:
+    return sum(f.stat().st_size for f in path.rglob("*") if f.is_file())
+
+
+def _plan(target: Path, settings: Settings, geometry: FrameGeometry, n_frames: int, *,
+          reclaimed: int = 0) -> dict[str, Any]:
+    """The store's growth for ``n_frames`` images; ValueError when the disk cannot hold it.
+
+    ``reclaimed``: bytes freed once the new store is in place (an old store replaced).
+    The size before compression is the bound: compression saves only about a tenth.
+    """
+    per = frame_bytes(settings, geometry)
+    need = n_frames * per
+    free = shutil.disk_usage(target.parent).free + reclaimed
+    shape = geometry.image_shape(settings.z.size, settings.upsample)
+    dtype = "float32" if geometry.dtype == "complex64" else "float64"
+    if need > free:
+        raise ValueError(
+            f"store {str(target)!r} would need up to {bytes_text(need)} for {n_frames} frames "
+            f"({bytes_text(per)} each: {shape[0]} planes of {shape[2]} x {shape[1]} pixels, I and "
+            f"Q as {dtype}) but its disk has {bytes_text(free)} free: free some space, put the "
+            "store on another disk, or image fewer planes or at a smaller upsample")
+    return {"frames": n_frames, "bytes": need, "bytes_per_frame": per,
+            "image_shape": list(shape), "dtype": dtype, "free": free, "store": str(target)}
 
 
 def _layout_text(layout: Any) -> Any:
@@ -152,7 +282,8 @@ def _layout_text(layout: Any) -> Any:
 
 def _run(given: list[Path], target: Path, settings: Settings, sched: str, client: Any, *,
          strict: bool, overwrite: bool, exists: bool, progress: bool,
-         layout: Any = None) -> dict[str, Any]:
+         layout: Any = None,
+         on_start: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """The run itself, once the arguments are checked (see :func:`run_batch`)."""
     # Distinct frames, and the checks that need no reading, before anything is written.
     frames_in: list[tuple[Path, str]] = []  # (absolute path, name as given)
@@ -171,13 +302,12 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
             frames_in.append((key, str(p)))
     n_frames = len(seen)
 
-    if exists and not overwrite:
+    fresh = overwrite or not exists  # a new store is laid out
+    if not fresh:
         old, geometry = stored_settings(target)
         diff = old.differences(settings)
         if diff:
-            raise ValueError(f"store {str(target)!r} was made with other settings ("
-                             + "; ".join(diff) + "): pass overwrite=True (--force on the "
-                             "command line) to start it again, or choose another store")
+            raise SettingsMismatchError(str(target), diff)
     else:
         found, refused = _reference(frames_in, strict, layout)
         for name, reason in refused:
@@ -188,12 +318,19 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
             raise ValueError(f"none of the {n_frames} frames can be imaged: "
                              + "; ".join(f"{s['name']}: {s['reason']}" for s in skipped[:3]))
         geometry = found
+        # Before the store is laid out: a refused run writes nothing.
+        plan = _plan(target, settings, geometry, len(frames_in),
+                     reclaimed=_folder_bytes(target) if exists else 0)
         create_store(target, settings, geometry, replace=exists)
 
     slots = register_frames(target, [p for p, _ in frames_in])
     done = read_index(target)["done"]
     todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, frames_in, strict=True)
             if not done[slot]]
+    if todo and not fresh:  # (a new store was checked before it was laid out)
+        plan = _plan(target, settings, geometry, len(todo))
+    if todo and on_start is not None:
+        on_start(plan)
     workers = schedule.cluster_workers(client) if client is not None \
         else schedule.local_workers(sched)
     job = Job(str(target), uuid.uuid4().hex, settings, geometry, strict, layout)
@@ -201,11 +338,15 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
                                  progress=progress, client=client) if todo else []
     skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
                 if r["status"] == "skipped"]
+    # Why frames are missing, kept in the store for `holoradar info` (by absolute path).
+    note_skipped(target, {str(Path(k["name"]).resolve()): k["reason"] for k in skipped},
+                 [str(p) for p in seen])
     return {"store": str(target), "frames": n_frames,
             "done": sum(r["status"] == "done" for r in records),
             "resumed": len(frames_in) - len(todo), "skipped": skipped, "seconds": 0.0,
             "scheduler": sched, "workers": workers,
-            "warnings": sorted({w for r in records for w in r.get("warnings", [])})}
+            "warnings": sorted({w for r in records for w in r.get("warnings", [])}),
+            "bytes_estimated": plan["bytes"] if todo else 0}
 
 
 def _skip(skipped: list[dict[str, str]], name: str, reason: str, strict: bool) -> None:

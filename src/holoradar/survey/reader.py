@@ -57,7 +57,8 @@ def open_survey(store: str | os.PathLike[str]) -> Any:
     idx = read_index(Path(store))
     n = idx["n"]
     arr = idx["group"]["image"]
-    image = da.from_zarr(arr, chunks=(1, *arr.shape[1:]))[:n]
+    image = da.from_array(_Checked(arr, str(store)), chunks=(1, *arr.shape[1:]), name=False,
+                          asarray=True, fancy=False)[:n]
     per_frame = {k: ("frame", idx[k]) for k in ("frame_x", "frame_y", "frame_z", "finished")}
     coords: dict[str, Any] = {
         "z": ("z", idx["z"], {"units": "m", "long_name": "range of the plane from the aperture"}),
@@ -74,6 +75,28 @@ def open_survey(store: str | os.PathLike[str]) -> Any:
         ds[k].attrs["units"] = "m"
     ds["finished"].attrs["units"] = "s since 1970-01-01 UTC"
     return ds
+
+
+class _Checked:
+    """A store's image array whose read errors are a ``ValueError`` naming the store.
+
+    A damaged chunk (a flipped bit in a compressed chunk, a truncated file) makes the
+    codecs raise their own errors (``RuntimeError`` from Blosc...) when the lazy
+    dataset is computed, far from :func:`open_survey`.
+    """
+
+    def __init__(self, arr: Any, store: str) -> None:
+        self.arr, self.store = arr, store
+        self.shape, self.dtype, self.ndim = arr.shape, arr.dtype, arr.ndim
+
+    def __getitem__(self, key: Any) -> np.ndarray:
+        try:
+            return np.asarray(self.arr[key])
+        except ValueError:
+            raise
+        except Exception as exc:  # zarr, numcodecs and the file system fail in many ways
+            raise ValueError(f"store {self.store!r} is damaged or unreadable "
+                             f"({type(exc).__name__}: {exc})") from None
 
 
 def frame_image(store: str | os.PathLike[str], frame: int | str) -> Image:

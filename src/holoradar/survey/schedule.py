@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 from collections.abc import Sequence
 from contextlib import nullcontext
 from typing import Any
 
 __all__ = ["DEFAULT_SCHEDULER", "LOCAL", "check_scheduler", "cluster_workers", "connect",
-           "local_workers", "process_pool", "run_tasks", "split"]
+           "local_workers", "process_pool", "run_tasks", "split", "stop_requested"]
 
 LOCAL = ("processes", "threads", "synchronous")
 DEFAULT_SCHEDULER = "processes"
@@ -23,7 +24,7 @@ DEFAULT_SCHEDULER = "processes"
 h5netcdf) holds the GIL most of the time, so threads do not scale (slower than
 one thread, measured); processes do (docs/surveys.md gives the figures)."""
 
-_POOL: dict[int, Any] = {}
+_POOL: dict[int, tuple[Any, Any]] = {}  # workers -> (the session's pool, its stop event)
 
 
 def check_scheduler(scheduler: str | None) -> str:
@@ -78,7 +79,10 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
 
     A task that raises stops the run: the local schedulers stop handing out
     tasks; on a cluster the remaining ones are cancelled. The exception is
-    raised here.
+    raised here. So is KeyboardInterrupt (Ctrl-C), once the local workers have
+    stopped: each finishes the frame in hand (``func`` asks :func:`stop_requested`
+    between frames) and starts no other; a second Ctrl-C while they finish
+    terminates worker processes at once.
     """
     if scheduler in LOCAL:
         # Here, not at import: concurrent.futures.process brings in multiprocessing.
@@ -88,8 +92,19 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
         from dask.diagnostics import ProgressBar
 
         delayed = [dask.delayed(func, pure=False)(t, job) for t in tasks]
-        extra = {"pool": process_pool(local_workers(scheduler))} \
-            if scheduler == "processes" else {}
+        pool: Any = None
+        stop = _LOCAL_STOP
+        if scheduler == "processes":
+            pool, stop = process_pool(local_workers(scheduler), with_stop=True)
+        elif scheduler == "threads":
+            # A pool of this run's own, so that an interrupted run can wait for the frames
+            # its threads are imaging before the caller counts what is stored.
+            from concurrent.futures import ThreadPoolExecutor
+
+            pool = ThreadPoolExecutor(local_workers(scheduler))
+        extra = {} if pool is None else {"pool": pool}
+        stop.clear()
+        _LOCAL_STOP.clear()
         with ProgressBar(minimum=1.0, out=sys.stderr) if progress else nullcontext():
             try:
                 results = dask.compute(*delayed, scheduler=scheduler, **extra)
@@ -99,6 +114,12 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
                     "a worker process of the local 'processes' scheduler died. Run from a "
                     "script? Its processes import the script again: put its code under "
                     "`if __name__ == '__main__':`, or pass scheduler='threads'") from exc
+            except KeyboardInterrupt:
+                _stop(pool, stop, scheduler)
+                raise
+            finally:
+                if scheduler == "threads":
+                    pool.shutdown(wait=True)
         return [r for recs in results for r in recs]
     from distributed import as_completed
 
@@ -124,29 +145,102 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
     return out
 
 
-def process_pool(workers: int) -> Any:
+_LOCAL_STOP = threading.Event()
+"""Set after Ctrl-C: the caller's own threads (the threads and synchronous schedulers)
+stop after the frame in hand."""
+
+_WORKER_STOP: list[Any] = []
+"""In a worker process: its pool's stop event (set by the caller after Ctrl-C)."""
+
+
+def stop_requested() -> bool:
+    """Whether the run was interrupted (Ctrl-C): a task stops before its next frame."""
+    return _LOCAL_STOP.is_set() or bool(_WORKER_STOP and _WORKER_STOP[0].is_set())
+
+
+def process_pool(workers: int, *, with_stop: bool = False) -> Any:
     """A pool of ``workers`` processes kept for the session (started once: later runs
     skip the start-up, a second or so of imports per process).
 
     The processes are forked from a server that has imported the survey code
     (``forkserver``, where the platform has it; else ``spawn``), so they start
-    fast and share no threads or locks with the caller.
+    fast and share no threads or locks with the caller. ``with_stop``: also return
+    the event that asks its workers to stop (:func:`stop_requested`).
     """
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    pool = _POOL.get(workers)
-    if pool is None:
+    entry = _POOL.get(workers)
+    if entry is None:
         method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
         ctx = mp.get_context(method)
         if method == "forkserver":
             ctx.set_forkserver_preload(["holoradar.survey.worker", "h5py"])
-        pool = ProcessPoolExecutor(workers, mp_context=ctx)
-        for old in _POOL.values():  # another size asked: let the old pool's processes go
+        stop = ctx.Event()
+        entry = (ProcessPoolExecutor(workers, mp_context=ctx, initializer=_start_worker,
+                                     initargs=(stop,)), stop)
+        for old, _ in _POOL.values():  # another size asked: let the old pool's processes go
             old.shutdown(wait=False)
         _POOL.clear()
-        _POOL[workers] = pool
-    return pool
+        if not _POOL_CLOSED_AT_EXIT:
+            import atexit
+
+            atexit.register(_close_pools)
+            _POOL_CLOSED_AT_EXIT.append(True)
+        _POOL[workers] = entry
+    return entry if with_stop else entry[0]
+
+
+_POOL_CLOSED_AT_EXIT: list[bool] = []
+
+
+def _close_pools() -> None:
+    """At exit, before modules are torn down: shut the session's pool, which would
+    otherwise be collected after concurrent.futures and print "Exception ignored"."""
+    for pool, _ in list(_POOL.values()):
+        pool.shutdown(wait=True)
+    _POOL.clear()
+
+
+def _start_worker(stop: Any) -> None:
+    """Run in each worker process as it starts: keep the pool's stop event, and leave
+    Ctrl-C to the caller.
+
+    A terminal sends SIGINT to the whole process group, workers included; left to
+    themselves they raise KeyboardInterrupt inside a task and print its traceback (and
+    Dask's failure to pickle it) over the user's console. The caller sets ``stop``
+    instead, and each worker stops after the frame in hand.
+    """
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _WORKER_STOP[:] = [stop]
+
+
+def _stop(pool: Any, stop: Any, scheduler: str) -> None:
+    """After Ctrl-C: stop the local workers, so that the store no longer changes.
+
+    Each worker finishes the frame in hand and starts no other (a frame is written
+    whole and marked done last, so the store stays consistent either way, but the
+    count the caller reports is then final); tasks not started are cancelled. A
+    second Ctrl-C while they finish terminates worker processes at once.
+    """
+    stop.set()
+    _LOCAL_STOP.set()
+    if pool is None:  # synchronous: the interrupted frame was the caller's own
+        return
+    for key, (p, _) in list(_POOL.items()):  # a pool shut down serves no other run
+        if p is pool:
+            del _POOL[key]
+    try:
+        pool.shutdown(wait=True, cancel_futures=True)
+    except KeyboardInterrupt:
+        if scheduler == "processes":
+            # The executor keeps its processes in a private attribute (Python 3.14
+            # adds terminate_workers()).
+            for proc in list((getattr(pool, "_processes", None) or {}).values()):
+                proc.terminate()
+        raise
 
 
 def connect(address: str) -> Any:

@@ -88,17 +88,49 @@ class Settings:
         for key, label, unit in (("z_m", "z", " m"), ("medium", "medium", ""),
                                  ("method", "method", ""), ("upsample", "upsample", "")):
             if mine[key] != other[key]:
-                out.append(f"{label}: the store has {_show(mine[key])}{unit}, this run asks "
-                           f"{_show(other[key])}{unit}")
+                out.append(f"{label}: " + _contrast(mine[key], other[key], unit))
         return out
 
 
-def _show(v: Any) -> str:
+def _contrast(stored: Any, asked: Any, unit: str) -> str:
+    """"the store has A, this run asks B": numbers to 6 digits (0.42, not
+    0.42000000000000004), more only where the two would otherwise read the same."""
+    for digits in (6, 9, 12, 17):
+        a, b = _show(stored, digits), _show(asked, digits)
+        if a != b:
+            return f"the store has {a}{unit}, this run asks {b}{unit}"
+    # Two lists of planes that differ only past the summary: name the first plane that does.
+    k = next(i for i, (u, v) in enumerate(zip(stored, asked, strict=True)) if u != v)
+    return (f"the store has {_show(stored)}{unit}, this run asks the same but for plane "
+            f"{k + 1}: {stored[k]!r}{unit} stored, {asked[k]!r}{unit} asked")
+
+
+def _show(v: Any, digits: int = 6) -> str:
+    """A setting as a person reads it, numbers to ``digits`` significant digits.
+
+    Examples
+    --------
+    >>> _show([0.38, 0.42000000000000004]), _show(list(np.arange(0.3, 0.5, 0.01)))
+    ('[0.38, 0.42]', '20 planes 0.3..0.49 (step 0.01)')
+    """
+
+    def num(x: float) -> str:
+        return repr(float(x)) if digits >= 17 else f"{x:.{digits}g}"
+
     if v is None:
         return "free space"
     if isinstance(v, dict):
-        eps = ", ".join(f"{complex(re, im):g}" for re, im in v["eps"])
-        return f"interfaces {v['z_interfaces_m']} m, eps ({eps}), {v['polarization']}"
+        eps = ", ".join(f"{num(re)}{num(im) if im < 0 else '+' + num(im)}j"
+                        for re, im in v["eps"])
+        tops = ", ".join(num(t) for t in v["z_interfaces_m"])
+        return f"interfaces [{tops}] m, eps ({eps}), {v['polarization']}"
     if isinstance(v, list) and len(v) > 6:
-        return f"{len(v)} planes {v[0]:g}..{v[-1]:g}"
+        steps = np.diff(v)
+        step = f" (step {num(float(np.mean(steps)))})" \
+            if np.allclose(steps, steps[0], rtol=1e-6, atol=0) else " (uneven steps)"
+        return f"{len(v)} planes {num(v[0])}..{num(v[-1])}{step}"
+    if isinstance(v, list):
+        return "[" + ", ".join(num(x) for x in v) + "]"
+    if isinstance(v, float):
+        return num(v)
     return repr(v) if isinstance(v, str) else str(v)

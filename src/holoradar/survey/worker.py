@@ -18,6 +18,7 @@ from ..data.hologram import Hologram
 from ..imaging.migrate import migrate
 from ..io import load
 from .frames import FrameGeometry, frame_position
+from .schedule import stop_requested
 from .settings import Settings
 from .store import write_frame
 
@@ -95,5 +96,11 @@ def _process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
 
 
 def process_chunk(chunk: Sequence[tuple[int, str, str]], job: Job) -> list[dict[str, Any]]:
-    """:func:`process_frame` on each ``(slot, path, name)`` of a task, in turn."""
-    return [process_frame(slot, path, name, job) for slot, path, name in chunk]
+    """:func:`process_frame` on each ``(slot, path, name)`` of a task, in turn; after
+    Ctrl-C (:func:`~holoradar.survey.schedule.stop_requested`) no further frame."""
+    out = []
+    for slot, path, name in chunk:
+        if stop_requested():  # the run was interrupted: leave the rest to a rerun
+            break
+        out.append(process_frame(slot, path, name, job))
+    return out

@@ -3,9 +3,10 @@
 Every command takes ``--help``, ``--json`` (a machine-readable summary on
 stdout) and ``--quiet``. A user's mistake (a bad argument, an unreadable or
 implausible file, an output that would destroy data) is one line on stderr,
-``error: ...``, and exit code 2; warnings are one line each. Outputs are
-checked before any work, never replace an input or an existing file unless
-``--force`` is given, and are written atomically with the user's umask.
+``error: ...``, and exit code 2; warnings are one line each; Ctrl-C (SIGINT)
+is one line, ``interrupted: ...``, and exit code 130. Outputs are checked
+before any work, never replace an input or an existing file unless ``--force``
+is given, and are written atomically with the user's umask.
 """
 
 from __future__ import annotations
@@ -30,19 +31,45 @@ def _show_warning(message: Any, category: type[Warning], filename: str, lineno: 
     click.echo(f"warning: {_one_line(str(message))} ({category.__name__})", err=True)
 
 
-def _fail(message: str, code: int, args: Any) -> None:
+def _fail(message: str, code: int, args: Any, prefix: str = "error: ") -> None:
     """One line on stderr; with --json also a JSON object on stdout for the caller."""
-    click.echo(f"error: {_one_line(message)}", err=True)
+    click.echo(f"{prefix}{_one_line(message)}", err=True)
     argv = sys.argv[1:] if args is None else list(args)
     if "--json" in argv:
         import json
 
-        click.echo(json.dumps({"error": _one_line(message), "exit_code": code}))
+        said = message if prefix == "error: " else prefix + message  # errors: as before
+        click.echo(json.dumps({"error": _one_line(said), "exit_code": code}))
     sys.exit(code)
 
 
+INTERRUPTED = 130
+"""Exit code after Ctrl-C (SIGINT): 128 + the signal's number, as shells report it."""
+
+
+class _InterruptError(Exception):
+    """A KeyboardInterrupt carried past click, which would print a blank line and abort."""
+
+
+def _interrupted(detail: str, args: Any) -> None:
+    """Ctrl-C: one line (what the command leaves, when it knows), exit code 130."""
+    if sys.stderr.isatty():
+        click.echo("", err=True)  # the terminal echoed ^C: start the line afresh
+    _fail(detail or "stopped before the end (outputs are written whole or not at all)",
+          INTERRUPTED, args, prefix="interrupted: ")
+
+
 class HoloradarGroup(click.Group):
-    """A click group whose user errors are one line and exit code 2, never a traceback."""
+    """A click group whose user errors are one line and exit code 2, never a traceback;
+    Ctrl-C is one line and exit code 130."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            # A command's KeyboardInterrupt may say what it leaves behind (batch: the
+            # frames stored); click would turn it into a bare Abort.
+            raise _InterruptError(str(exc)) from None
 
     def main(self, args: Any = None, prog_name: str | None = None,  # type: ignore[override]
              complete_var: str | None = None, standalone_mode: bool = True,
@@ -61,7 +88,11 @@ class HoloradarGroup(click.Group):
                   else exc.exit_code, args)
         except click.exceptions.Exit as exc:
             sys.exit(exc.exit_code)
-        except click.Abort:
+        except _InterruptError as exc:
+            _interrupted(str(exc), args)
+        except click.Abort as exc:
+            if isinstance(exc.__cause__, KeyboardInterrupt):  # Ctrl-C while parsing
+                _interrupted("", args)
             click.echo("error: aborted", err=True)
             sys.exit(1)
         except ValueError as exc:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import glob
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -69,7 +70,8 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
     is its pose's centre (or the centre of its coordinates). Bad frames are
     reported and skipped; a rerun resumes, imaging only frames not yet done.
     """
-    from ...survey import run_batch
+    from ...survey import BatchInterrupted, SettingsMismatchError, run_batch
+    from ...survey.batch import bytes_text
 
     files = _expand(frames)
     zs = depth_ranges(z)
@@ -85,20 +87,99 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
         check_ranges(zs, z, "--z", aperture, f_max, medium, escape=None)
         check_ground(medium, medium_spec, aperture, f_max, escape=None)
     warn_above_ground(zs, medium, medium_spec)
-    s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
-                  scheduler=scheduler, strict=strict, overwrite=force,
-                  progress=report.progress and not report.as_json, layout=layout)
+
+    def started(plan: dict[str, Any]) -> None:
+        report.line(f"imaging {_frames(plan['frames'])} into {out}: up to "
+                    f"{bytes_text(plan['bytes'])} ({bytes_text(plan['bytes_per_frame'])} a "
+                    f"frame before compression); {bytes_text(plan['free'])} free on its disk")
+
+    try:
+        s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
+                      scheduler=scheduler, strict=strict, overwrite=force,
+                      # A bar redraws its line with carriage returns: in a log file (stderr
+                      # not a terminal) those are hundreds of lines of noise.
+                      progress=report.progress and not report.as_json and sys.stderr.isatty(),
+                      layout=layout, on_start=started)
+    except BatchInterrupted as exc:
+        raise KeyboardInterrupt(f"{exc.stored} of {_frames(exc.frames)} "
+                                f"{'is' if exc.frames == 1 else 'are'} stored in {out}; "
+                                "run the same command again to resume") from None
+    except SettingsMismatchError as exc:  # the library's message names its overwrite=True
+        raise ValueError(f"{out} was made with other settings ({'; '.join(exc.differences)})"
+                         ": pass --force to start it again (its frames are removed), or "
+                         "choose another store") from None
     for w in s.get("warnings", []):  # raised in the workers: shown here once each
         category, _, message = w.partition(": ")
         click.echo(f"warning: {' '.join(message.split())} ({category})", err=True)
     for sk in s["skipped"]:
         click.echo(f"warning: skipped {sk['name']}: {' '.join(sk['reason'].split())}",
                    err=True)
+    if s["done"] == 0:  # the store holds what it held: no "wrote"
+        stored = f"{_frames(s['resumed'])} already stored in {out}"
+        nothing = f"nothing imaged: {stored}, {len(s['skipped'])} skipped" if s["skipped"] \
+            else f"nothing to do: {stored}"
+        report.done(s, [nothing], result=[nothing])
+        return
     report.done(s, [
         f"imaged {s['done']} frame(s), {s['resumed']} already done, {len(s['skipped'])} "
         f"skipped, in {s['seconds']:.1f} s ({s['scheduler']})",
         f"wrote {out}",
     ], result=[f"wrote {out}"])
+
+
+def _frames(n: int) -> str:
+    return f"{n} frame" if n == 1 else f"{n} frames"
+
+
+def store_info(path: Path) -> tuple[dict[str, Any], list[str]]:
+    """``holoradar info`` of a folder: the summary and lines describing a survey store.
+
+    A folder that is not a survey store is a ``ValueError`` naming what ``info`` reads.
+    """
+    from ...survey import describe_store
+    from ...survey.batch import bytes_text
+    from ...survey.store import is_survey
+
+    if not is_survey(path):
+        raise ValueError(f"{path} is a folder that is not a holoradar survey store: info "
+                         "reads a file, or a survey store (.zarr) written by holoradar batch")
+    d = describe_store(path)
+    st, geo = d["settings"], d["geometry"]
+    z = np.asarray(st["z_m"], float)
+    oy, ox = d["image_shape"][1:]
+    f = np.asarray(geo["frequency_hz"], float) / 1e9
+    step = " x ".join("?" if v is None else f"{v * 1e3:.4g}" for v in d["pixel_m"])
+    packed = f"compressed ({', '.join(d['compressors'])})" if d["compressors"] \
+        else "uncompressed"
+    rows = [
+        ("frames", f"{d['frames_stored']} stored of {d['frames_expected']}"),
+        ("planes z (m)", _span(z)),
+        ("frame grid", f"{geo['ny']} x {geo['nx']} elements, pitch "
+                       f"{geo['pitch_m'][0] * 1e3:.4g} x {geo['pitch_m'][1] * 1e3:.4g} mm, "
+                       + ("scanned transceiver" if geo["monostatic"] else "receiver array")),
+        ("frequency (GHz)", _span(f)),
+        ("image", f"{oy} x {ox} pixels a plane, step {step} mm (upsample "
+                  f"{st['upsample']}), I and Q as {d['dtype']}, {packed}"),
+        ("ground", d["ground"]),
+        ("method", st["method"]),
+    ]
+    if d["extent_m"] is not None:
+        x0, x1, y0, y1 = d["extent_m"]
+        rows.append(("frame centres", f"x {x0:.4g} .. {x1:.4g} m, y {y0:.4g} .. {y1:.4g} m"))
+    rows.append(("created", str(d["created"])))
+    lines = [f"{path.name}: a holoradar survey store ({bytes_text(d['bytes_on_disk'])} "
+             "on disk)"]
+    lines += [f"  {k:16s} {v}" for k, v in rows]
+    lines += [f"  not stored: {m['name']}: {' '.join(m['reason'].split())}"
+              for m in d["not_stored"]]
+    lines += [f"  damaged: {m['name']}: {m['reason']}" for m in d["damaged"]]
+    return {"file": str(path), "kind": "survey store", **d}, lines
+
+
+def _span(v: np.ndarray) -> str:
+    if v.size == 1:
+        return f"{v[0]:.6g}"
+    return f"{v[0]:.6g} .. {v[-1]:.6g} ({v.size}, step {(v[-1] - v[0]) / (v.size - 1):.6g})"
 
 
 def _first_frame(files: list[Path], layout: str | None) -> Any:

@@ -53,12 +53,21 @@ def describe(obj: Any) -> dict[str, Any]:
 
 
 @click.command()
-@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("file", type=click.Path(exists=True, path_type=Path))
 @click.option("--layout", default=None, metavar="KEY=VALUE,...",
               help="For a user's file: where the hologram is (see holoradar image --help).")
 @output_options
 def info(file: Path, layout: str | None, report: Reporter) -> None:
-    """Show what FILE holds: its variables, and the hologram or image read from it."""
+    """Show what FILE holds: its variables, and the hologram or image read from it.
+
+    FILE may also be a survey store (a .zarr folder written by holoradar batch): its
+    frames stored and missing, planes, grid and settings.
+    """
+    if file.is_dir():
+        from .batch import store_info
+
+        report.done(*store_info(file))
+        return
     from ...io import load, read_history
     from ...io.readers import read_variables
 
