@@ -123,9 +123,11 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
             raise ValueError("image: a volume (several ranges) needs hologram= (a point's "
                              "response along range comes from the hologram); without it pass "
                              "one plane, e.g. image.plane(z)")
+        from .psf import ApertureModel
         from .window import WindowModel
 
-        model = WindowModel(vol, medium)
+        model = ApertureModel(vol, medium) if ApertureModel.applies(vol) else \
+            WindowModel(vol, medium)
     result = clean(vol, model, fa, max_objects=int(max_objects))
     rows = _rows(result, vol, model, medium, interval)
     if "line" in ks:
@@ -156,7 +158,8 @@ def _rows(result: CleanResult, vol: Volume, model: Any, medium: Any,
         s2 = float(result.noise.sigma2[c.peak_index])
         amp2 = abs(c.amplitude) ** 2
         snr = 10 * np.log10(amp2 / s2) if s2 > 0 else np.inf
-        if not np.all(np.isfinite(std)) and getattr(model, "kind", "") == "window":
+        if not np.all(np.isfinite(std)) and getattr(model, "kind", "") in ("window",
+                                                                       "aperture"):
             mu, nu = model.widths(pos[2])
             snr_lin = amp2 / s2 if s2 > 0 else np.inf
             # Cramer-Rao of a peak's position: 1/sqrt(2 SNR beta^2), beta^2 = mu^2/3.

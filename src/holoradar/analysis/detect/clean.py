@@ -7,13 +7,20 @@ threshold of the stated false-alarm rate (:mod:`.noise`); ``V`` is the variance 
 the models' own error, taken proportional to each model,
 
     V(r) = sum_i eps_i^2 |m_i(r)|^2,
-    eps_i^2 = max(0, sum_lobe |R_i|^2 - sum_lobe sigma^2) / sum_lobe |m_i|^2,
+    eps_i^2 = max(0, sum_E |R_i|^2 - n_E s_i^2) / sum_E |m_i|^2,
 
-measured on the main lobe of object ``i`` right after its subtraction (the
-energy the model leaves there beyond the noise, relative to the model's). So a
-sidelobe or a ringing that a model reproduces to within ``eps`` is never an
-object, and a weak object next to a strong one must stand out of the strong
-one's model error as well as out of the noise.
+measured right after its subtraction on its main lobe and first sidelobes ``E`` (the
+model's ``error_region``; its main lobe where a model gives none): the energy the
+model leaves there beyond the noise, relative to the model's. The first
+sidelobes belong in that measure: a rectangular aperture's are only 13 dB down,
+and a model right on the main lobe and wrong on them (the analytic ``sinc``
+without the focus's chirp) leaves them as "objects". So a sidelobe or a ringing
+that a model reproduces to within ``eps`` is never an object, and a weak object
+next to a strong one must stand out of the strong one's model error as well as
+out of the noise. ``s_i^2`` is the noise of the plane once object ``i`` is
+subtracted, the median of ``|R_i|^2`` over ``ln 2`` (an exponential's median;
+the local estimate made before the subtraction holds the object itself), and
+``n_E`` the number of pixels of the region ``E``.
 
 Stopping rule: the pass stops when that maximum falls below ``t`` (or after
 ``max_objects``).
@@ -60,8 +67,9 @@ def clean(volume: Volume, model: Any, false_alarm: float, *, max_objects: int = 
     """Find objects one by one (module notes).
 
     ``model.start()`` gives the residual image to begin with and
-    ``model.fit(residual, index, position)`` the model image of one object and its
-    main lobe (optionally ``model.position``/``model.std`` after the fit).
+    ``model.fit(residual, index, position)`` the model image of one object, its
+    main lobe and a dict (optionally ``position``, ``std`` and ``error_region``, the
+    pixels of the object's plane where its error is measured).
     """
     R = model.start()
     V = np.zeros(R.shape)
@@ -78,6 +86,7 @@ def clean(volume: Volume, model: Any, false_alarm: float, *, max_objects: int = 
         stat = np.abs(R) ** 2 / np.where(s2 > 0, s2, np.inf)
         idx = tuple(int(i) for i in np.unravel_index(int(np.argmax(stat)), stat.shape))
         frac, value = refine_peak(stat, idx)  # type: ignore[arg-type]
+        bright = value   # over the plane's typical noise (its own sidelobes left out)
         # The decision: the candidate's own reference, its guard cells left out.
         s2c, n_ref = candidate_noise(R, mask, idx, volume.x, volume.y, noise.cell)
         t = threshold_resels(false_alarm * max(noise.n_cells, 1.0), noise.resels, n_ref)
@@ -89,11 +98,17 @@ def clean(volume: Volume, model: Any, false_alarm: float, *, max_objects: int = 
                           "above the threshold", RuntimeWarning, stacklevel=3)
             break
         peak = volume.coords(*frac)
+        if hasattr(model, "detection"):
+            model.detection = (float(bright), float(t))   # how far above the threshold
         m, lobe, info = model.fit(R, idx, peak)
         R = R - m
         iz = idx[0]
-        e_model = float(np.sum(np.abs(m[iz][lobe]) ** 2))
-        e_left = float(np.sum(np.abs(R[iz][lobe]) ** 2 - noise.sigma2[iz][lobe]))
+        region = info.get("error_region", lobe)
+        e_model = float(np.sum(np.abs(m[iz][region]) ** 2))
+        # The noise there: the plane's median of |R|^2 over ln 2 once the object is
+        # subtracted (the local estimate, made before, holds the object itself).
+        s2_after = float(np.median(np.abs(R[iz]) ** 2)) / np.log(2)
+        e_left = float(np.sum(np.abs(R[iz][region]) ** 2)) - s2_after * int(np.sum(region))
         eps2 = min(max(e_left, 0.0) / e_model, 1.0) if e_model > 0 else 1.0
         V = V + eps2 * np.abs(m) ** 2
         mask |= lobe
