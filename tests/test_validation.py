@@ -61,9 +61,9 @@ def test_bad_frequency(f):
 
 
 def test_gain_medium_refused():
-    with pytest.raises(ValueError, match=r"Im\(eps\) >= 0"):
+    with pytest.raises(ValueError, match="negative imaginary part"):
         hr.Medium.half_space(0.3, 2.5 - 0.1j)
-    with pytest.raises(ValueError, match=r"Im\(eps\) >= 0"):
+    with pytest.raises(ValueError, match="negative imaginary part"):
         hr.Medium.layered([0.3, 0.4], [2.5, 4 - 1j])
 
 
