@@ -133,7 +133,7 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
     if "line" in ks:
         from .lines import group_lines
 
-        rows = group_lines(rows, result.noise.cell)
+        rows = group_lines(rows, result.noise.cell, model)
     if "point" not in ks:
         rows = [r for r in rows if r["kind"] != "point"]
     df = pd.DataFrame(rows, columns=COLUMNS)

@@ -288,6 +288,10 @@ class ApertureModel:
 
         cx, cy = self.cell(ap)
         by, bx = self._box(ap, start, FIT_CELLS if with_range else 1.0)
+        # Every (u/2)-th pixel: the image is band-limited to the elements' band
+        # |p| <= pi/d, which two samples per pitch hold (the upsampled pixels add none).
+        stride = max(ap.u // 2, 1)
+        by, bx = by[::stride], bx[::stride]
         M = ap.matrix(by, bx)
         d = plane[np.ix_(by, bx)].ravel()
         d = d / (np.sqrt(float(np.vdot(d, d).real)) or 1.0)
@@ -352,15 +356,26 @@ class ApertureModel:
             return self._result(ap, r, a, box)
         if self.ap is None:
             # The pitch: the candidate whose response explains the most of the brightest
-            # object's main lobe and first sidelobes, at the position (and range) fitted
-            # with the first candidate (which does not alias where one may), the chosen
-            # one refitted.
+            # object's main lobe and first sidelobes, at the position fitted with the
+            # first candidate (the main lobe hardly depends on the pitch), the chosen one
+            # refitted.
             aps = [self._candidate(i) for i in range(len(self.candidates))]
-            r0 = self._fit(aps[0], plane, position[:2], with_range=True)[0]
-            shares = [self._share(ap, plane, r0)[2] for ap in aps]
+            r0 = self._fit(aps[0], plane, position[:2], with_range=False)[0]
+            shares = [self._share(aps[i], plane, r0)[2] for i in range(len(aps))]
             self.ap = aps[int(np.argmax(shares))]
-            position = tuple(r0)
-        r, a, _, box = self._fit(self.ap, plane, position, with_range=True)
+            position = (float(r0[0]), float(r0[1]), position[2])
+        r, a, _, box = self._fit(self.ap, plane, position[:2], with_range=False)
+        # A point off the plane images defocused: fit its range too, and keep that fit
+        # if it explains the fit box down to the noise (the residual's energy at most
+        # twice the noise's there). A piece of a longer object (a bar) also fits
+        # better with a range, by a broader defocused spot, but never down to the
+        # noise: it stays in the plane and CLEAN strings it along the object.
+        r3, a3, share3, box3 = self._fit(self.ap, plane, (*r[:2], self.ap.z),
+                                         with_range=True)
+        e_box = float(np.sum(np.abs(plane[box3]) ** 2))
+        noise_box = float(np.median(np.abs(plane) ** 2)) / np.log(2) * int(box3.sum())
+        if (1.0 - share3) * e_box <= 2.0 * noise_box:
+            r, a, box = r3, a3, box3
         return self._result(self.ap, r, a, box)
 
     def _result(self, ap: _Aperture, r: np.ndarray, a: complex, box: np.ndarray
