@@ -63,7 +63,8 @@ def test_noise_free_point_is_recovered_exactly():
 
 # --------------------------------------------------------------------- wideband
 @pytest.mark.parametrize("eps,source", [(2.5, hr.PlaneWave()),
-                                        (8.0, hr.PointSource((-0.25, 0.0, 0.0)))])
+                                        pytest.param(8.0, hr.PointSource((-0.25, 0.0, 0.0)),
+                                                     marks=pytest.mark.slow)])
 def test_two_gigahertz_band_recovers_eps_within_5_percent(eps, source):
     """9-11 GHz (4 frequencies), 20 dB: the delay z0 + n*depth and the curvature
     z0 + depth/n fix n and the depth together. The interval measured is about +-0.6%

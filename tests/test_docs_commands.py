@@ -37,7 +37,14 @@ def test_the_pages_show_commands():
     assert commands(REPO / "README.md")
 
 
-@pytest.mark.parametrize("page", [p for p in PAGES if commands(p)], ids=lambda p: p.name)
+# The pages whose commands take several seconds end to end (each command is also tested
+# on its own in test_cli_commands.py): run with make test-slow.
+_LONG_PAGES = {"cli.md", "viewer.md", "surveys.md"}
+
+
+@pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.slow)
+                                  if p.name in _LONG_PAGES else p
+                                  for p in PAGES if commands(p)], ids=lambda p: p.name)
 def test_every_documented_command_runs(page, tmp_path, monkeypatch):
     (tmp_path / "examples").symlink_to(REPO / "examples")
     monkeypatch.chdir(tmp_path)

@@ -149,16 +149,25 @@ def test_tilted_aperture_matches_the_exact_layered_adjoint():
     so the error is the taper's ringing, which has no closed form and falls as the
     grid grows. Measured: 0.77% RMS on the default grid (M d >= 4x the largest
     element-pixel offset), 0.25% with 8x padding; a level aperture at the same
-    height: 0.23%. Bounds: 2% and 1%, and the larger grid must be at least twice
-    closer: the convergence is what shows the remap itself exact. A wrong sign of
-    the air term fails it (and the focusing tests)."""
+    height: 0.23%. Bound: 2% (0.5% level); that a larger grid converges, which shows the remap
+    itself exact, is the slow test below. A wrong sign of the air term fails it (and
+    the focusing tests)."""
+    sand = hr.Medium.half_space(0.3, 2.5 + 0.05j)
+    tilted = hr.Pose((0.0, -0.12, 0.08), tilt=np.radians(35), azimuth=np.radians(90))
+    assert _kernel_error(tilted, sand, True) < 0.02
+    assert _kernel_error(hr.Pose((0.0, 0.0, 0.08)), sand, True) < 0.005
+
+
+@pytest.mark.slow
+def test_tilted_aperture_adjoint_converges_as_the_grid_grows():
+    """The same case on a grid padded 8x: at least twice closer (0.25% measured against
+    0.77%), and within 1%: the convergence shows the remap itself exact (slow: the
+    padded grid is 64x larger)."""
     sand = hr.Medium.half_space(0.3, 2.5 + 0.05j)
     tilted = hr.Pose((0.0, -0.12, 0.08), tilt=np.radians(35), azimuth=np.radians(90))
     e_default = _kernel_error(tilted, sand, True)
     e_big = _kernel_error(tilted, sand, 8.0)
-    assert e_default < 0.02
     assert e_big < 0.01 and e_big < e_default / 2
-    assert _kernel_error(hr.Pose((0.0, 0.0, 0.08)), sand, True) < 0.005
 
 
 @pytest.mark.parametrize("eps", [2.5, 6.0])

@@ -72,6 +72,8 @@ def _assert_exact(store: Path, paths: list[Path], holos: list, **kw) -> np.ndarr
 
 
 # (a) a dask.distributed cluster of 2 worker processes gives the single-process results
+@pytest.mark.slow  # a real two-process cluster takes 15 s to start and run; the default
+# process scheduler's test below covers the same equality across processes
 def test_cluster_of_two_workers_equals_single_process(survey200, tmp_path: Path) -> None:
     from distributed import LocalCluster
 
