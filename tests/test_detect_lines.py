@@ -107,3 +107,25 @@ def test_three_parallel_bars_are_three_lines_with_their_spacing():
     assert sorted(df.x) == pytest.approx(xs, abs=_cell() / 4)
     assert df.azimuth_deg.to_numpy() == pytest.approx(90.0, abs=2.0)
     assert df.spacing.to_numpy() == pytest.approx(0.15, rel=0.05)
+
+
+@pytest.mark.slow
+def test_a_plate_is_one_area_with_its_outline():
+    # A metal plate 12 x 8 cm (f = -1, physical optics) 10 cm deep in sand under a
+    # 32 x 32 array at 1.25 cm, 30 cm above it: one area. Its outline (the hull of the
+    # components) lies within half a cell of the edges: extents within a cell, the area
+    # within the perimeter times half a cell; its centroid within a quarter cell.
+    sand = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+    plate = hr.PlanarTarget.from_shape("rectangle", 0.40, center=(0.02, -0.01),
+                                       reflection=-1, width=0.12, height=0.08)
+    h = hr.simulate(hr.Scene(sand, hr.PlaneWave(), [plate]), hr.Aperture.grid(32, 0.0125),
+                    9.9e9, include_surface=False, snr_db=30, seed=1)
+    df = detect(hr.migrate(h, 0.40, medium=sand, upsample=4), medium=sand)
+    assert list(df.kind) == ["area"], df[["kind", "x", "y", "snr_db"]]
+    cell = hr.theory.lateral_resolution(h.wavelength, sand.apparent_distance(0.40), 0.40)
+    row = df.iloc[0]
+    assert abs(row.x - 0.02) < cell / 4 and abs(row.y + 0.01) < cell / 4
+    assert abs(row.length - 0.12) < cell and abs(row.width - 0.08) < cell
+    assert abs(row.area - 0.12 * 0.08) < 0.40 * cell / 2
+    outline = np.array(df.attrs["outlines"][0])
+    assert outline.shape[1] == 2 and np.allclose(outline[0], outline[-1])

@@ -60,8 +60,9 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         Expected number of false objects per resolution cell on noise (default
         1e-3); sets the threshold from the image's own noise (docs/detect.md).
     kinds : sequence of str
-        Which kinds to report: ``"point"``, ``"line"`` (``"area"`` is accepted;
-        areas are not detected yet).
+        Which kinds to report: ``"point"``, ``"line"``, ``"area"`` (a planar
+        reflector or void: its outline polygon in ``df.attrs["outlines"]``, keyed
+        by row).
     hologram : Hologram, optional
         The hologram the image was migrated from (one frame, level aperture). With
         it each object is the exact point response fitted to the hologram: its
@@ -81,13 +82,13 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         ``kind``; ``x``, ``y``, ``range`` (metres, the image's axes; the range from
         the aperture); ``depth`` below the surface with ``depth_low``/``depth_high``
         (95 %: the range's uncertainty and the permittivity's interval); ``length``,
-        ``width``, ``azimuth_deg`` (degrees from +x towards +y; lines),
+        ``width``, ``azimuth_deg`` (degrees from +x towards +y; lines and areas),
         ``x_start``, ``y_start``, ``x_end``, ``y_end`` (a line's ends), ``spacing``
         (to the nearest parallel line); ``amplitude_db`` (20 log10 of the object's
         image amplitude), ``snr_db`` (its intensity over the local noise),
         ``x_std``, ``y_std``, ``range_std`` (metres), ``model_error_db`` (what the
-        model leaves of the object, relative, dB). ``df.attrs`` holds the threshold,
-        the noise and the cell.
+        model leaves of the object, relative, dB), ``area`` (m^2; areas). ``df.attrs``
+        holds the threshold, the noise, the cell and the areas' ``outlines``.
 
     Raises
     ------
@@ -130,6 +131,10 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
             WindowModel(vol, medium)
     result = clean(vol, model, fa, max_objects=int(max_objects))
     rows = _rows(result, vol, model, medium, interval)
+    if "area" in ks:
+        from .areas import group_areas
+
+        rows = group_areas(rows, result.noise.cell, model)
     if "line" in ks:
         from .lines import group_lines
 
@@ -140,7 +145,8 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
     df.attrs.update({"threshold": float(result.noise.t), "false_alarm": fa,
                      "resolution_cell": [float(c) for c in result.noise.cell],
                      "n_cells": float(result.noise.n_cells),
-                     "model": model.kind})
+                     "model": model.kind,
+                     "outlines": {i: r["outline"] for i, r in enumerate(rows) if "outline" in r}})
     return df
 
 

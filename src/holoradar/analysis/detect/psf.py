@@ -300,6 +300,10 @@ class ApertureModel:
         def cost(v: np.ndarray) -> float:
             if len(v) == 3 and not z_lo <= v[2] <= z_hi:
                 return 1.0 + min(abs(v[2] - z_lo), abs(v[2] - z_hi))
+            # The object stays within a cell of its peak (its fit box is there).
+            off = np.hypot((v[0] - start[0]) / cx, (v[1] - start[1]) / cy)
+            if off > 1.0:
+                return float(off)
             p = np.einsum("pe,e->p", M, ap.g(*v))  # (BLAS's zgemv: 10x slower here)
             n = float(np.vdot(p, p).real)
             return -abs(np.vdot(p, d)) ** 2 / n if n > 0 else 0.0

@@ -10,7 +10,7 @@ __all__ = ["COLUMNS", "as_eps_interval", "depth_interval"]
 
 COLUMNS = ["kind", "x", "y", "range", "depth", "depth_low", "depth_high", "length", "width",
            "azimuth_deg", "amplitude_db", "snr_db", "x_std", "y_std", "range_std",
-           "x_start", "y_start", "x_end", "y_end", "spacing", "model_error_db"]
+           "x_start", "y_start", "x_end", "y_end", "spacing", "model_error_db", "area"]
 """Columns of :func:`holoradar.detect`'s table, in order."""
 
 Z95 = 1.959963984540054  # two-sided 95 % of a normal distribution
