@@ -31,12 +31,16 @@ browser:
 	else echo "$(BROWSER_PKGS) missing and not installable here: the browser tests will skip"; \
 	fi
 
+# The suite runs on every core (pytest-xdist, a test file per worker so that its shared
+# set-up is made once), each worker's BLAS on one thread: two suites' worth of BLAS
+# threads on two cores would only wait on each other.
+PYTEST_PARALLEL := -n auto --dist loadfile
 test: $(STAMP) browser
 	$(BIN)/ruff check src tests benchmarks examples
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q $(PYTEST_PARALLEL)
 
 test-slow: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m slow
+	MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q -m slow $(PYTEST_PARALLEL)
 
 # The documentation's pictures of the viewer, taken by its browser tests.
 screenshots: $(STAMP) browser
