@@ -334,3 +334,28 @@ def test_line_needs_the_vector_model():
     with pytest.raises(ValueError, match="target"):
         hr.autofocus(h, medium_model=_model(), target="plane")
 
+
+
+def test_the_search_runs_its_blas_on_one_thread(monkeypatch):
+    # Small matrix products on a busy machine: BLAS threads only wait for a core (a
+    # 4-frequency search took twice as long with two busy processes beside it).
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from holoradar.imaging import point_response
+
+    seen = []
+    original = point_response.PointResponse.match
+
+    def match(self, *a, **k):
+        seen.append(max((p["num_threads"] for p in threadpool_info()
+                         if p["user_api"] == "blas"), default=1))
+        return original(self, *a, **k)
+
+    monkeypatch.setattr(point_response.PointResponse, "match", match)
+    truth = hr.Medium.half_space(0.30, 4.0)
+    scene = hr.Scene(truth, hr.PlaneWave(), [hr.PointTarget((0.01, 0.0, 0.40))])
+    h = hr.simulate(scene, hr.Aperture.grid(8, 0.03), 9.9e9, include_surface=False,
+                    snr_db=30, seed=0)
+    with threadpool_limits(limits=2, user_api="blas"):   # whatever the caller's setting
+        hr.autofocus(h, medium_model=hr.Medium.half_space(0.30, 3.0))
+    assert seen and max(seen) == 1
