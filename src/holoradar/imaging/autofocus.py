@@ -50,11 +50,12 @@ from ..physics.medium import Medium
 from .migrate import migrate
 from .point_response import PointResponse
 
-# Imported on first use (holoradar._lazy): scipy.stats alone is several times numpy's
-# import, and `import holoradar` should cost little more than numpy.
+# Imported on first use (holoradar._lazy): `import holoradar` should cost little more
+# than numpy. The two quantiles below come from scipy.special, not scipy.stats, whose
+# import alone (0.4 s) would double a first single-frequency search.
 sfft = lazy_module("scipy.fft")
 _opt = lazy_module("scipy.optimize")
-_stats = lazy_module("scipy.stats")
+_special = lazy_module("scipy.special")
 
 __all__ = ["AutofocusResult", "autofocus"]
 
@@ -166,7 +167,7 @@ class AutofocusResult:
 
 
 def _quantile(confidence: float) -> float:
-    return float(_stats.norm.ppf(0.5 + confidence / 2))
+    return float(_special.ndtri(0.5 + confidence / 2))   # the normal quantile
 
 
 def _one_blas_thread(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -710,7 +711,9 @@ class _Search:
         s2f = max(float(np.vdot(rf, rf).real) / max(2 * n_complex - 4 - 2 * n_amp, 1), floor)
         detection = pr.energy * pr.match(gf, phase=False)[0] / (2 * s2f)
         # With one amplitude per frequency the output sums n_amp such variables (Gamma).
-        threshold = float(_stats.gamma.isf(_FALSE_ALARM / self.trials, n_amp))
+        # Gamma(n_amp, 1)'s upper quantile: Q(n_amp, x) = p, Q the regularised upper
+        # incomplete gamma function.
+        threshold = float(_special.gammainccinv(n_amp, _FALSE_ALARM / self.trials))
         # Residual variance per real component: a phase-only residual has one real
         # component per sample (along the phase), a field residual two.
         r, g, a = pr.residual(eps, z, xy)
