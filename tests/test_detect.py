@@ -152,6 +152,8 @@ def test_depth_interval_from_the_permittivity_interval():
     ({"eps_interval": (3.0, 2.0), "medium": hr.Medium.half_space(0.3, 2.5)}, "eps_interval"),
     ({"eps_interval": (2.0, 3.0)}, "medium"),
     ({"eps_interval": "wide", "medium": hr.Medium.half_space(0.3, 2.5)}, "eps_interval"),
+    ({"max_objects": 0}, "max_objects"),
+    ({"max_objects": "x"}, "max_objects"),
 ])
 def test_bad_input_names_the_argument(kwargs, message):
     img = hr.Image(np.ones((5, 5), complex), np.arange(5) * 0.01, np.arange(5) * 0.01,

@@ -137,3 +137,14 @@ def test_a_large_array_with_many_frames_is_judged_on_a_part_of_it():
     h = h.with_data(np.stack([h.data] * 10))
     assert check_iq_sign(h).sign == "I+iQ"
     assert check_iq_sign(hr.conjugate(h)).sign == "I-iQ"
+
+
+def test_bad_arguments_are_refused_by_name():
+    ap = hr.Aperture.grid(16, 0.0125)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))]), ap, 9.9e9)
+    with pytest.raises(ValueError, match=r"^z must"):
+        hr.check_iq_sign(h, z="abc")
+    with pytest.raises(ValueError, match=r"^z must"):
+        hr.check_iq_sign(h, z=-0.3)
+    with pytest.raises(TypeError, match="medum"):
+        hr.check_iq_sign(h, medum=hr.Medium.half_space(0.3, 2.5))

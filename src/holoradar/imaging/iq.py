@@ -182,9 +182,26 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
     >>> check_iq_sign(h).sign, check_iq_sign(conjugate(h)).sign
     ('I+iQ', 'I-iQ')
     """
+    import inspect
+
+    unknown = sorted(set(migrate_options) - set(inspect.signature(migrate).parameters))
+    if unknown:
+        raise TypeError(f"check_iq_sign: {', '.join(map(repr, unknown))} is not an option of "
+                        "holoradar.migrate (e.g. medium=, frame=)")
+    if z is not None:
+        try:
+            z_given = np.atleast_1d(np.asarray(z, float))
+        except (TypeError, ValueError):
+            raise ValueError(f"z must be ranges in metres (a number or a sequence), got "
+                             f"{z!r}") from None
+        if not (z_given.size and np.all(np.isfinite(z_given)) and np.all(z_given > 0)):
+            raise ValueError(f"z must be finite ranges in front of the aperture (> 0 m), got "
+                             f"{z!r}")
     try:
-        zs = default_ranges(hologram) if z is None else np.atleast_1d(np.asarray(z, float))
+        zs = default_ranges(hologram) if z is None else z_given
         zs = _spread(np.unique(zs), MAX_PLANES)
+        # Only what shapes the focus; the caller's other imaging options (upsampling,
+        # windows, fields of view) do not change which side it lies on.
         opts = {k: v for k, v in migrate_options.items() if k in ("medium", "frame", "method")}
         # The whole padded grid: the glare's focus (the horn's mirror image) often lies
         # beside the array, and it focuses in front as any scatterer does. A level

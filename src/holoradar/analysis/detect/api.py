@@ -129,6 +129,9 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
 
         model = ApertureModel(vol, medium) if ApertureModel.applies(vol) else \
             WindowModel(vol, medium)
+    if isinstance(max_objects, bool) or not isinstance(max_objects, int | np.integer) \
+            or max_objects < 1:
+        raise ValueError(f"max_objects must be a whole number >= 1, got {max_objects!r}")
     result = clean(vol, model, fa, max_objects=int(max_objects))
     rows = _rows(result, vol, model, medium, interval)
     if "area" in ks:

@@ -63,7 +63,9 @@ def depth_interval(depth: float, range_std: float, eps: float,
     frequency the wave front's curvature fixes the apparent depth ``d/n``
     (paraxial), so ``d' = d sqrt(eps'/eps)``; across a band the two-way delay
     fixes ``n d``, so ``d' = d sqrt(eps/eps')``. The bounds are the extremes over
-    the interval's ends, each widened by ``1.96`` range standard deviations.
+    the interval's ends, each widened by ``1.96`` range standard deviations. A range
+    that was not fitted (``range_std`` NaN: an object found on one plane without the
+    hologram) gives NaN bounds: the depth is then unknown within the focus's length.
 
     Examples
     --------
@@ -71,8 +73,15 @@ def depth_interval(depth: float, range_std: float, eps: float,
     [0.0866, 0.1118]
     >>> [round(v, 4) for v in depth_interval(0.10, 0.0, 4.0, (3.0, 5.0), True)]
     [0.0894, 0.1155]
+    >>> depth_interval(0.10, float("nan"), 4.0, None, False)
+    (nan, nan)
     """
-    s = Z95 * range_std if np.isfinite(range_std) else 0.0
+    if not np.isfinite(range_std):
+        # The range was not fitted (an object found on one plane of the image alone):
+        # one frequency's focus is tens of centimetres long, so the depth is unknown
+        # within it, not exact. Say so rather than state a zero-width interval.
+        return float("nan"), float("nan")
+    s = Z95 * range_std
     ends = [depth]
     if eps_interval is not None and eps > 0:
         for e in eps_interval:
