@@ -129,14 +129,27 @@ def test_image_command_warns_once_with_the_fix(tmp_path):
     assert res.exit_code == 0 and "IQSignWarning" not in res.output
 
 
-def test_a_large_array_with_many_frames_is_judged_on_a_part_of_it():
+def test_a_large_array_with_many_frames_is_judged_on_a_part_of_it(monkeypatch):
     # 300 x 300 elements and 10 frames: the check looks at the central 128 x 128 and 4
     # frames (a few FFTs of 256 x 256), and the centre still focuses the point in front
     ap = hr.Aperture.grid(300, 0.005)
     h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.05, 0.0, 0.3))]), ap, ONE)
     h = h.with_data(np.stack([h.data] * 10))
+    from holoradar.imaging import iq
+
+    shapes = []
+    real_migrate = iq.migrate
+
+    def spy(holo, *a, **k):
+        shapes.append(holo.data.shape)
+        return real_migrate(holo, *a, **k)
+
+    monkeypatch.setattr(iq, "migrate", spy)
     assert check_iq_sign(h).sign == "I+iQ"
     assert check_iq_sign(hr.conjugate(h)).sign == "I-iQ"
+    # what was imaged: at most 4 frames of at most 128 x 128 elements
+    assert shapes and all(s[-2:] == (128, 128) and (len(s) == 2 or s[0] <= 4)
+                          for s in shapes)
 
 
 def test_bad_arguments_are_refused_by_name():
