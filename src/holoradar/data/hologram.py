@@ -339,6 +339,22 @@ class Image:
             ``(x, y, z)``; with ``unbiased`` a
             :class:`~holoradar.analysis.detect.peak.PeakPosition` (a 3-tuple with
             ``.std``).
+
+        Examples
+        --------
+        A point 10 cm deep in sand under an array 30 cm above it, one frequency:
+        the brightest pixel lies short of it (the focus is long and the adjoint's
+        weighting pulls it towards the array); the fit finds the point.
+
+        >>> import holoradar as hr
+        >>> sand = hr.Medium.half_space(0.30, 2.5)
+        >>> h = hr.simulate(hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget((0.0, 0.0, 0.40))]),
+        ...                 hr.Aperture.grid(16, 0.02), 9.9e9, include_surface=False,
+        ...                 snr_db=40, seed=0)
+        >>> img = hr.migrate(h, [0.34, 0.37, 0.40, 0.43], medium=sand)
+        >>> x, y, z = img.peak(unbiased=True, hologram=h, medium=sand)
+        >>> abs(z - 0.40) < 0.005
+        True
         """
         if unbiased:
             from ..analysis.detect.peak import unbiased_peak

@@ -349,6 +349,11 @@ def describe_store(target: Path) -> dict[str, Any]:
     Reads the small arrays and lists the image's chunk files; the images themselves
     are not read, so this is quick for any store.
 
+    Parameters
+    ----------
+    target : Path
+        The store (a ``.zarr`` folder that :func:`holoradar.survey.run_batch` wrote).
+
     Returns
     -------
     dict
