@@ -118,6 +118,35 @@ def test_geojson_lines_and_areas():
     assert area["properties"]["x_start"] is None    # NaN is null: valid JSON
 
 
+def test_geojson_area_is_detects_outline(tmp_path):
+    # A metal plate 10 x 6 cm 10 cm deep in sand: one area, whose GeoJSON Polygon is the
+    # outline hr.detect found (the hull of its components), not a rectangle.
+    plate = hr.PlanarTarget.from_shape("rectangle", 0.40, center=(0.02, -0.01),
+                                       reflection=-1, width=0.10, height=0.06)
+    h = hr.simulate(hr.Scene(SAND, hr.PlaneWave(), [plate]), hr.Aperture.grid(24, 0.0125),
+                    9.9e9, include_surface=False, snr_db=30, seed=1)
+    img = hr.save(hr.migrate(h, 0.40, medium=SAND, upsample=4), tmp_path / "plate.nc")
+    out = tmp_path / "plate.geojson"
+    run("detect", img, *GROUND, "-o", out, "-q")
+    ref = hr.detect(hr.load(img), medium=SAND)
+    assert list(ref.kind) == ["area"]
+    (feat,) = json.loads(out.read_text())["features"]
+    assert feat["geometry"]["type"] == "Polygon"
+    ring = np.array(feat["geometry"]["coordinates"][0])
+    outline = np.array(ref.attrs["outlines"][0])
+    assert ring.shape == outline.shape and np.allclose(ring[0], ring[-1])
+    assert ring == pytest.approx(outline, abs=1e-12)
+
+
+def test_geojson_closes_an_open_outline():
+    df = pd.DataFrame([{"kind": "area", "x": 0.5, "y": 0.5, "length": 1.0, "width": 1.0,
+                        "azimuth_deg": 0.0}])
+    df.attrs["outlines"] = {0: [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]}
+    (area,) = geojson(df, {}, "scene")["features"]
+    assert area["geometry"]["coordinates"] == [[[0.0, 0.0], [1.0, 0.0], [0.5, 1.0],
+                                                [0.0, 0.0]]]
+
+
 def test_hologram_file_imaged_on_z_then_fitted(files):
     res = run("detect", files["holo"], "--z", "0.42", *GROUND, "--eps-interval", "2.2,2.8",
               "--json")
@@ -127,6 +156,24 @@ def test_hologram_file_imaged_on_z_then_fitted(files):
     _same(_from_records(doc["objects"])[ref.columns], ref)
     assert doc["n_objects"] == 2 and doc["metadata"]["eps_interval"] == [2.2, 2.8]
     assert (ref.depth_high - ref.depth_low > 0.01).all()   # the eps interval widens it
+
+
+def test_raised_hologram_fitted_from_its_height(tmp_path):
+    # A level array 5 cm up (pose z): imaged on ranges from the array through the ground
+    # the flags give in world z, as holoradar image does; a hologram FILE and an image with
+    # its --hologram both give the point's true depth below the surface.
+    ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((0.0, 0.0, 0.05)))
+    h = hr.simulate(hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.02, 0.01, 0.42))]), ap,
+                    9.9e9, include_surface=False, snr_db=40, seed=1)
+    holo = hr.save(h, tmp_path / "raised.nc")
+    img = hr.save(hr.migrate(h, 0.37, medium=SAND, upsample=4), tmp_path / "raised_img.nc")
+    for args in (["--z", "0.37"], ["--hologram", holo]):
+        src = holo if args[0] == "--z" else img
+        p = json.loads(run("detect", src, *args, *GROUND, "--json").stdout)["objects"]
+        assert len(p) == 1, p
+        assert p[0]["depth"] == pytest.approx(0.12, abs=2e-3)
+        assert p[0]["range"] == pytest.approx(0.37, abs=2e-3)
+        assert [p[0]["x"], p[0]["y"]] == pytest.approx([0.02, 0.01], abs=2e-3)
 
 
 def test_quiet_keeps_the_table(files):
@@ -181,40 +228,98 @@ def test_bad_inputs_named(files, tmp_path):
     assert not list(tmp_path.glob("*.csv")) and not list(tmp_path.glob("*.json"))
 
 
-@pytest.fixture(scope="module")
-def survey(tmp_path_factory):
-    """Two overlapping frames (16 x 16 at 1.25 cm, 10 cm apart along x, at y = 0.1 m) over
-    one point 12 cm deep in sand at world (0.04, 0.11)."""
+@pytest.fixture(scope="module", params=[0.0, 0.05], ids=["level0", "raised"])
+def survey(tmp_path_factory, request):
+    """Two overlapping frames (16 x 16 at 1.25 cm, 10 cm apart along x, at y = 0.1 m, their
+    arrays at world height ``z0``) over one point 12 cm deep in sand at world (0.04, 0.11):
+    the store's plane is its range from the arrays, 0.42 - z0."""
+    z0 = request.param
     d = tmp_path_factory.mktemp("survey")
     scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.04, 0.11, 0.42))])
     paths = []
     for i, x0 in enumerate((0.0, 0.1)):
-        ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((x0, 0.1, 0.0)))
+        ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((x0, 0.1, z0)))
         h = hr.simulate(scene, ap, 9.9e9, include_surface=False, snr_db=40, seed=i)
         paths.append(hr.save(h, d / f"frame{i}.nc"))
-    hr.survey.run_batch(paths, d / "s.zarr", z=[0.42], medium=SAND, upsample=4,
+    plane = round(0.42 - z0, 6)
+    hr.survey.run_batch(paths, d / "s.zarr", z=[plane], medium=SAND, upsample=4,
                         scheduler="synchronous")
-    return d
+    return {"dir": d, "z0": z0, "plane": plane}
 
 
-@pytest.mark.parametrize("plane", [[], ["--z", "0.42"]])
-def test_survey_objects_in_survey_coordinates_once(survey, plane):
-    out = survey / f"objects{len(plane)}.geojson"
-    run("detect", survey / "s.zarr", *plane, "-o", out, "--force")
+@pytest.mark.parametrize("mode", ["hologram", "plane"])
+def test_survey_objects_in_survey_coordinates_once(survey, mode):
+    # Both the hologram's fit and one stored plane: the object's world position and its
+    # depth below the surface, whatever the arrays' height (the planes are ranges from
+    # the arrays, the ground seen from their height).
+    d, z0 = survey["dir"], survey["z0"]
+    plane = [] if mode == "hologram" else ["--z", f"{survey['plane']:g}"]
+    out = d / f"objects_{mode}.geojson"
+    run("detect", d / "s.zarr", *plane, "-o", out, "--force")
     doc = json.loads(out.read_text())
     feats = doc["features"]
     assert len(feats) == 1, [f["properties"] for f in feats]   # seen by both frames: once
     p = feats[0]["properties"]
-    cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, SAND.apparent_distance(0.42), 0.2)
+    seen = hr.Medium.half_space(0.30 - z0, SAND.eps[1])
+    cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, seen.apparent_distance(0.42 - z0), 0.2)
     assert abs(p["x"] - 0.04) < cell / 4 and abs(p["y"] - 0.11) < cell / 4
     assert feats[0]["geometry"]["coordinates"] == pytest.approx([p["x"], p["y"]])
     assert p["frame"] == "frame0.nc"       # the frame it lies nearest the centre of
+    per_frame = doc["metadata"]["per_frame"]
+    # One frequency: no finite range cell (null); the lateral cell bounds the depth.
+    range_cell = per_frame[0]["resolution_cell"][2] or cell
+    assert abs(p["depth"] - 0.12) < min(range_cell, cell) / 4, (p["depth"], cell)
+    assert abs(p["range"] - (0.42 - z0)) < min(range_cell, cell) / 4
     assert p["depth"] == pytest.approx(0.12, abs=0.01)
     assert "survey" in doc["coordinate_frame"]["frame"]
-    assert [f["frame"] for f in doc["metadata"]["per_frame"]] == ["frame0.nc", "frame1.nc"]
+    assert [f["frame"] for f in per_frame] == ["frame0.nc", "frame1.nc"]
+    assert [f["array_z_m"] for f in per_frame] == pytest.approx([z0, z0])
+
+
+def test_survey_geojson_area_is_the_frames_outline(tmp_path):
+    # A plate under a raised frame away from the origin: the store's GeoJSON Polygon is
+    # the outline hr.detect finds on the frame's stored plane (world pixels, the ground
+    # seen from the array), kept through the survey's gathering of the frames.
+    plate = hr.PlanarTarget.from_shape("rectangle", 0.40, center=(0.52, 0.19),
+                                       reflection=-1, width=0.10, height=0.06)
+    ap = hr.Aperture.grid(24, 0.0125, pose=hr.Pose((0.5, 0.2, 0.05)))
+    h = hr.simulate(hr.Scene(SAND, hr.PlaneWave(), [plate]), ap, 9.9e9,
+                    include_surface=False, snr_db=30, seed=1)
+    frame = hr.save(h, tmp_path / "plate.nc")
+    store = tmp_path / "s.zarr"
+    hr.survey.run_batch([frame], store, z=[0.35], medium=SAND, upsample=4,
+                        scheduler="synchronous")
+    out = tmp_path / "plate.geojson"
+    run("detect", store, "--z", "0.35", "-o", out, "-q")
+    seen = hr.Medium.half_space(0.25, SAND.eps[1])
+    ref = hr.detect(hr.survey.frame_image(store, 0).plane(0.35), medium=seen)
+    assert list(ref.kind) == ["area"] and ref.depth[0] == pytest.approx(0.10, abs=0.01)
+    (feat,) = json.loads(out.read_text())["features"]
+    assert feat["geometry"]["type"] == "Polygon"
+    assert feat["properties"]["depth"] == pytest.approx(ref.depth[0], abs=1e-12)
+    ring = np.array(feat["geometry"]["coordinates"][0])
+    assert ring == pytest.approx(np.array(ref.attrs["outlines"][0]), abs=1e-12)
+    assert abs(ring[:, 0].mean() - 0.52) < 0.03 and abs(ring[:, 1].mean() - 0.19) < 0.03
+
+
+def test_survey_stale_hologram_refused_in_cli_terms(tmp_path):
+    # A frame's file changed since the batch: one line naming the frame and the CLI's
+    # ways out (batch again, --z), no Python keyword.
+    scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.0, 0.0, 0.42))])
+    ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((0.0, 0.0, 0.05)))
+    h = hr.simulate(scene, ap, 9.9e9, include_surface=False, snr_db=40, seed=1)
+    frame = hr.save(h, tmp_path / "frame.nc")
+    hr.survey.run_batch([frame], tmp_path / "s.zarr", z=[0.37], medium=SAND, upsample=4,
+                        scheduler="synchronous")
+    hr.save(hr.Hologram(h.data[::-1], h.x, h.y, h.frequency, pose=h.pose), frame,
+            overwrite=True)
+    res = run("detect", tmp_path / "s.zarr", ok=False)
+    one_line_error(res, "frame.nc", "holoradar batch", "--z")
+    assert "migrate_options" not in res.output and "={" not in res.output
 
 
 def test_survey_refuses_ground_flags_and_hologram(survey, files):
-    one_line_error(run("detect", survey / "s.zarr", *GROUND, ok=False), "--eps/--z-surface")
-    one_line_error(run("detect", survey / "s.zarr", "--hologram", files["holo"], ok=False),
+    store = survey["dir"] / "s.zarr"
+    one_line_error(run("detect", store, *GROUND, ok=False), "--eps/--z-surface")
+    one_line_error(run("detect", store, "--hologram", files["holo"], ok=False),
                    "--hologram")

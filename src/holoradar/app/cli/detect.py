@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -140,15 +141,50 @@ def _detect(img: Any, **kwargs: Any) -> Any:
 
 
 def _fit(img: Any, holo: Any, medium: Any, opts: dict[str, Any], args: dict[str, Any],
-         name: str) -> Any:
-    """``detect`` with the hologram's fit; its refusals name the option that gave it."""
+         name: str, advice: str) -> Any:
+    """``detect`` with the hologram's fit; its refusals name the option (or the frame) that
+    gave it and say what to do in the command's terms (``advice``)."""
     try:
         return _detect(img, hologram=holo, medium=medium, migrate_options=opts, **args)
     except ValueError as exc:
         msg = str(exc)
-        if msg.startswith(("hologram", "image does not come", "image is not")):
+        if msg.startswith("image is not"):
+            differ = re.search(r"\(they differ by [^)]*\)", msg)
+            raise ValueError(f"{name}: the image is not this hologram's migration"
+                             f"{' ' + differ.group(0) if differ else ''}: {advice}") from None
+        if msg.startswith("image does not come"):
+            raise ValueError(f"{name}: the image's grid is not this hologram's elements at a "
+                             f"whole upsampling: {advice}") from None
+        if msg.startswith("hologram must hold one frame"):
+            raise ValueError(f"{name}: the hologram holds several frames (data shape "
+                             f"{np.shape(holo.data)}); {advice}") from None
+        if msg.startswith("hologram must lie on a level aperture"):
+            raise ValueError(f"{name}: the hologram's array is tilted (its pose), which "
+                             f"the point fit does not support yet; {advice}") from None
+        if msg.startswith("hologram"):
             raise ValueError(f"{name}: {msg}") from None
         raise
+
+
+def _level(holo: Any, medium: Any) -> tuple[Any, Any]:
+    """A level hologram at a height as the fit takes it: on its own plane (identity pose)
+    with the ground seen from that plane, as ``migrate`` images it (ranges from the
+    array); its position across is left to the caller."""
+    from dataclasses import replace
+
+    from ...data.pose import IDENTITY
+
+    return replace(holo, pose=IDENTITY), _from_array(medium, float(holo.pose.center[2]))
+
+
+def _from_array(medium: Any, height: float) -> Any:
+    """The ground seen from an array at world height ``height`` (``migrate``'s shift):
+    interfaces at ranges from the array, so that depths below the surface come out."""
+    from ...imaging.oblique import _shifted
+
+    if medium is None or height == 0.0:
+        return medium
+    return _shifted(medium, height)
 
 
 def _from_image(path: Path, img: Any, z: str | None, hologram: Path | None,
@@ -163,7 +199,12 @@ def _from_image(path: Path, img: Any, z: str | None, hologram: Path | None,
                                      "plane, from the image alone), not both", param_hint="--z")
         holo = read_hologram(hologram, layout, check)
         info["hologram"] = str(hologram)
-        return _fit(img, holo, medium, _options_of(img), args, "--hologram"), info
+        if holo.pose.is_level:
+            holo, medium = _level(holo, medium)
+        return _fit(img, holo, medium, _options_of(img), args, "--hologram",
+                    "give the hologram FILE was imaged from (with the ground flags it was "
+                    "imaged through), or --z RANGE to search one plane from the image "
+                    "alone"), info
     volume = bool(img.has_z_axis) and np.asarray(img.z).size > 1
     if z is not None:
         zs = depth_ranges(z)
@@ -192,17 +233,19 @@ def _from_hologram(path: Path, holo: Any, z: str | None, medium: Any,
     zs = depth_ranges(z)
     check_planes(holo, zs, z, medium, spec, check)
     img = migrate(holo, zs, medium=medium, upsample=4, progress=report.progress)
-    return _fit(img, holo, medium, {}, args, "FILE"), {"input": "hologram", "upsample": 4}
+    if holo.pose.is_level:
+        # The image is on the array's own axes, its planes ranges from the array.
+        holo, medium = _level(holo, medium)
+    return _fit(img, holo, medium, {}, args, "FILE",
+                "image it with holoradar image and search one plane of the image with "
+                "--z"), {"input": "hologram", "upsample": 4}
 
 
 def _from_store(path: Path, z: str | None, spec: dict[str, Any], args: dict[str, Any],
                 report: Reporter) -> tuple[Any, dict[str, Any], Any]:
     """Every frame searched, the objects in survey coordinates, duplicates merged."""
-    from dataclasses import replace
-
     import pandas as pd
 
-    from ...data.pose import IDENTITY
     from ...io import load
     from ...survey import frame_image
     from ...survey.store import read_index, stored_settings
@@ -237,41 +280,72 @@ def _from_store(path: Path, z: str | None, spec: dict[str, Any], args: dict[str,
     tables = []
     for i in frames:
         img = frame_image(path, i)
+        name = str(idx["frame_name"][i])
         if plane is None:
             holo = holograms[i]
             c = holo.pose.center
-            # The fit works in the frame's own coordinates (a level array at z = 0); the
-            # image's pixels are the frame's world position plus offsets.
+            # The fit works in the frame's own coordinates (a level array at z = 0, the
+            # ground seen from its height as migrate imaged it: the planes are ranges from
+            # the array); the image's pixels are the frame's world position plus offsets.
             local = type(img)(img.data, img.x - c[0], img.y - c[1], img.z, img.frequency,
                               img.method, has_z_axis=True)
             opts = {"method": settings.method, **_options_of(img)}
-            df = _fit(local, replace(holo, pose=IDENTITY), medium, opts, args,
-                      f"frame {idx['frame_name'][i]}")
-            for col in ("x", "x_start", "x_end"):
-                df[col] = df[col] + c[0]
-            for col in ("y", "y_start", "y_end"):
-                df[col] = df[col] + c[1]
+            flat, seen = _level(holo, medium)
+            df = _fit(local, flat, seen, opts, args, f"frame {name}",
+                      f"its hologram {idx['frame_path'][i]} is not the file the store was "
+                      "imaged from (changed since holoradar batch?): run holoradar batch "
+                      "again, or give --z RANGE to search one stored plane of each frame "
+                      "from the images alone")
+            shift = (c[0], c[1])
         else:
-            df = _detect(img.plane(plane), medium=medium, **args)
+            # The stored planes are ranges from the frame's array: its ground is seen from
+            # the array's height (the frame's z).
+            df = _detect(img.plane(plane), medium=_from_array(medium, float(idx["frame_z"][i])),
+                         **args)
+            shift = (0.0, 0.0)
+        df = _to_survey(df, shift)
         # Each frame reports the objects under its array: one beyond it is seen from the
         # side, fitted poorly, and left to the frame above it.
+        outlines = df.attrs.get("outlines") or {}
+        df["_outline"] = pd.Series([outlines.get(n) for n in range(len(df))], index=df.index,
+                                   dtype=object)
         under = df["x"].between(img.x[0], img.x[-1]) & df["y"].between(img.y[0], img.y[-1])
         df = df[under].reset_index(drop=True)
-        df["frame"] = str(idx["frame_name"][i])
+        df["frame"] = name
         df["_off"] = np.hypot(df["x"] - idx["frame_x"][i], df["y"] - idx["frame_y"][i])
         df["_cell"] = max(df.attrs["resolution_cell"][:2])
         tables.append(df)
-        report.line(f"frame {idx['frame_name'][i]}: {len(df)} object(s)")
+        report.line(f"frame {name}: {len(df)} object(s)")
     cols = [*tables[0].columns]
     full = pd.concat([t for t in tables if len(t)], ignore_index=True) if any(
         len(t) for t in tables) else pd.DataFrame(columns=cols)
     merged = _merge(full)
+    # The areas' outlines travel as a column through the concatenation and the merge.
+    outlines = {n: o for n, o in enumerate(merged.pop("_outline")) if isinstance(o, list)} \
+        if "_outline" in merged else {}
+    merged.attrs = {"outlines": outlines}
     info = {"input": "survey", "frames": len(frames), "model": "hologram" if plane is None
             else "window", "plane_m": plane, "per_frame": [
-                {"frame": str(idx["frame_name"][i]), "threshold": t.attrs.get("threshold"),
+                {"frame": str(idx["frame_name"][i]), "array_z_m": float(idx["frame_z"][i]),
+                 "threshold": t.attrs.get("threshold"),
                  "n_cells": t.attrs.get("n_cells"), "resolution_cell": t.attrs.get(
                      "resolution_cell")} for i, t in zip(frames, tables, strict=True)]}
     return merged, info, medium
+
+
+def _to_survey(df: Any, shift: tuple[float, float]) -> Any:
+    """A frame's table moved across by ``shift`` (its array's position): positions, line
+    ends and the areas' outlines."""
+    dx, dy = float(shift[0]), float(shift[1])
+    if dx == 0.0 and dy == 0.0:
+        return df
+    for col in ("x", "x_start", "x_end"):
+        df[col] = df[col] + dx
+    for col in ("y", "y_start", "y_end"):
+        df[col] = df[col] + dy
+    df.attrs["outlines"] = {k: [[float(u) + dx, float(v) + dy] for u, v in ring]
+                            for k, ring in df.attrs.get("outlines", {}).items()}
+    return df
 
 
 def _merge(df: Any) -> Any:
@@ -302,11 +376,13 @@ def _records(df: Any) -> list[dict[str, Any]]:
 def geojson(df: Any, metadata: dict[str, Any], frame: str) -> dict[str, Any]:
     """The objects as a GeoJSON FeatureCollection in a local metric frame.
 
-    Points are ``Point``, lines ``LineString`` (their ends), areas ``Polygon`` (the
-    rectangle of their length, width and azimuth about the centre); the properties
-    are the table's row. Coordinates are ``(x, y)`` in metres in the scene's (or the
-    survey's) frame, not longitude and latitude: the top-level ``coordinate_frame``
-    member says so (RFC 7946 dropped the ``crs`` member).
+    Points are ``Point``, lines ``LineString`` (their ends), areas ``Polygon``: the
+    outline ``hr.detect`` found (``df.attrs["outlines"]``, keyed by row position, a
+    closed ring), or without one the rectangle of their length, width and azimuth
+    about the centre; the properties are the table's row. Coordinates are ``(x, y)``
+    in metres in the scene's (or the survey's) frame, not longitude and latitude: the
+    top-level ``coordinate_frame`` member says so (RFC 7946 dropped the ``crs``
+    member).
 
     Examples
     --------
@@ -316,11 +392,17 @@ def geojson(df: Any, metadata: dict[str, Any], frame: str) -> dict[str, Any]:
     {'type': 'Point', 'coordinates': [0.1, 0.2]}
     """
     features = []
+    outlines = df.attrs.get("outlines") or {}
     for n, row in enumerate(_records(df)):
         kind = row.get("kind")
         ends = [row.get(k) for k in ("x_start", "y_start", "x_end", "y_end")]
         if kind == "line" and all(v is not None for v in ends):
             geom = {"type": "LineString", "coordinates": [ends[:2], ends[2:]]}
+        elif kind == "area" and outlines.get(n):
+            ring = [[float(u), float(v)] for u, v in outlines[n]]
+            if ring[0] != ring[-1]:
+                ring.append(list(ring[0]))
+            geom = {"type": "Polygon", "coordinates": [ring]}
         elif kind == "area":
             length, width = row.get("length") or 0.0, row.get("width") or 0.0
             az = math.radians(row.get("azimuth_deg") or 0.0)
