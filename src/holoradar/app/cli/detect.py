@@ -454,7 +454,10 @@ def table_lines(df: Any) -> list[str]:
     head = "depth cm [95 %]" if depth else "range cm +- std"
     lines = [f"  #  {'kind':<6} {'x cm':>7} {'y cm':>7}  {head:<22} {'amp dB':>7} {'SNR dB':>7}"]
     for n, r in enumerate(df.to_dict("records")):
-        if depth:
+        if depth and not np.isfinite(r["depth_low"]):
+            # found on one plane, its range not fitted: the plane's depth, not a bound
+            where = f"{r['depth'] * 100:.1f} (the plane's)"
+        elif depth:
             where = f"{r['depth'] * 100:.1f} [{r['depth_low'] * 100:.1f}, " \
                     f"{r['depth_high'] * 100:.1f}]"
         else:
