@@ -42,28 +42,26 @@ COVER = np.pi / 4
 
 
 def convex_hull(p: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull of points (n, 2) (Andrew's monotone chain).
+    """Counter-clockwise convex hull of points (n, 2) (Qhull, through scipy.spatial),
+    starting at the lowest-leftmost vertex; fewer than three distinct points, or points
+    on one line, are returned as they are (sorted).
 
     Examples
     --------
     >>> convex_hull(np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]])).tolist()
     [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
     """
-    pts = sorted({(float(a), float(b)) for a, b in p})
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.array(sorted({(float(a), float(b)) for a, b in np.asarray(p, float)}), float)
     if len(pts) < 3:
-        return np.array(pts, float)
-
-    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        out: list[tuple[float, float]] = []
-        for q in seq:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (q[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (q[0] - out[-2][0])) <= 0:
-                out.pop()
-            out.append(q)
-        return out
-
-    lower, upper = half(pts), half(pts[::-1])
-    return np.array(lower[:-1] + upper[:-1], float)
+        return pts.reshape(-1, 2)
+    try:
+        v = ConvexHull(pts).vertices          # counter-clockwise in 2-D
+    except QhullError:                        # all on one line: no area
+        return pts
+    v = np.roll(v, -int(np.argmin(v)))        # pts are sorted: the smallest index first
+    return pts[v]
 
 
 def polygon_area(poly: np.ndarray) -> float:
