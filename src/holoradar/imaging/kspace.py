@@ -245,6 +245,9 @@ class _Plan:
         B = Hc.shape[1]
         nz, oy, ox = out.shape[-3:]
         size = self.order.size
+        ptr = self.ptr.tolist()              # Python ints: no NumPy scalar per plane
+        block_end = self.block_end.tolist()
+        add = np.add.reduce                  # np.sum without its wrapper, per plane
         for c0 in range(0, nz, _CHUNK):
             c1 = min(nz, c0 + _CHUNK)
             # Whole blocks: a live block's tail (already zeroed by its drops) comes along.
@@ -253,11 +256,11 @@ class _Plan:
             for b in range(n_blocks):
                 s0, s1 = b * _BLOCK, (b + 1) * _BLOCK
                 hb, sb = Hc[b], self.step[b]
-                j1 = min(c1, int(self.block_end[b]) + 1)
+                j1 = min(c1, block_end[b] + 1)
                 for j in range(c0, j1):
-                    np.sum(hb, axis=1, out=spec[:, j - c0, s0:s1])
+                    add(hb, axis=1, out=spec[:, j - c0, s0:s1])
                     hb *= sb
-                    e0, e1 = self.ptr[b * (nz + 1) + j], self.ptr[b * (nz + 1) + j + 1]
+                    e0, e1 = ptr[b * (nz + 1) + j], ptr[b * (nz + 1) + j + 1]
                     if e1 > e0:
                         hb[:, self.f_ev[e0:e1], self.c_ev[e0:e1]] = 0
                 spec[:, j1 - c0:, s0:s1] = 0

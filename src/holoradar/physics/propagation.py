@@ -459,7 +459,14 @@ class _PlaneOperator(ABC):
         return -1 if self.fft_shape[0] * self.fft_shape[1] >= 128 * 128 else 1
 
     def _fft(self, a: np.ndarray) -> np.ndarray:
-        return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=self.workers)
+        My, Mx = self.fft_shape
+        if a.shape[-2] >= My:
+            return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=self.workers)
+        # Padded: along x over the recorded rows only (the padding rows are zeros and
+        # stay zeros), then along y: the same spectrum, fewer 1-D transforms and no
+        # zero-padded copy of the whole grid before the first pass.
+        rows = sfft.fft(a, n=Mx, axis=-1, workers=self.workers)
+        return sfft.fft(rows, n=My, axis=-2, workers=self.workers, overwrite_x=True)
 
     def _ifft_crop(self, A: np.ndarray) -> np.ndarray:
         return ifft2_cropped(A, self.shape, self.workers)
