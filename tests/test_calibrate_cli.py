@@ -10,11 +10,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 import holoradar as hr
+from cli_helpers import one_line_error, run
 from holoradar import calibrate as cb
-from holoradar.app.cli import main
 
 X = (np.arange(8) - 3.5) * 0.025
 F = np.array([9.5e9, 9.9e9])
@@ -22,19 +21,8 @@ HORN = hr.PointSource((0.0, -0.25, -0.05), pattern_exponent=2, axis=(0.0, 0.5, 1
 HORN_OPTS = ("--horn", "0,-0.25,-0.05", "--horn-axis", "0,0.5,1", "--pattern", "2")
 
 
-def run(*args: object, ok: bool = True):
-    res = CliRunner().invoke(main, [str(a) for a in args])
-    if ok:
-        assert res.exit_code == 0, res.output
-    return res
 
 
-def one_line_error(res, *needles: str) -> None:
-    assert res.exit_code == 2, res.output
-    errors = [ln for ln in res.output.splitlines() if ln.startswith("error: ")]
-    assert len(errors) == 1 and "Traceback" not in res.output, res.output
-    for n in needles:
-        assert n in errors[0], errors[0]
 
 
 @pytest.fixture(scope="module")

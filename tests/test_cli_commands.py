@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.io
-from click.testing import CliRunner
 
 import holoradar as hr
+from cli_helpers import one_line_error, run
 from holoradar.app.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
@@ -21,22 +21,8 @@ F = 9.9e9
 SCENE = REPO / "examples" / "scenes" / "sand_box.toml"
 
 
-def run(*args: str, ok: bool = True) -> object:
-    res = CliRunner().invoke(main, [str(a) for a in args])
-    if ok:
-        assert res.exit_code == 0, res.output
-    return res
 
 
-def one_line_error(res: object, *needles: str) -> None:
-    """A user mistake: exit code 2, one line starting 'error:', no traceback."""
-    assert res.exit_code == 2, res.output
-    lines = [ln for ln in res.output.splitlines() if ln.strip()]
-    errors = [ln for ln in lines if ln.startswith("error: ")]
-    assert len(errors) == 1, res.output
-    assert "Traceback" not in res.output and "Aborted" not in res.output
-    for n in needles:
-        assert n in errors[0], errors[0]
 
 
 @pytest.fixture(scope="module")

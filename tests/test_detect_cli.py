@@ -9,10 +9,9 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
 
 import holoradar as hr
-from holoradar.app.cli import main
+from cli_helpers import one_line_error, run
 from holoradar.app.cli.detect import geojson
 
 warnings.filterwarnings("ignore", category=hr.AliasingWarning)
@@ -22,19 +21,8 @@ SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
 GROUND = ["--eps", "2.5+0.0125j", "--z-surface", "0.3"]
 
 
-def run(*args: object, ok: bool = True) -> object:
-    res = CliRunner().invoke(main, [str(a) for a in args])
-    if ok:
-        assert res.exit_code == 0, res.output
-    return res
 
 
-def one_line_error(res: object, *needles: str) -> None:
-    assert res.exit_code == 2, res.output
-    errors = [ln for ln in res.output.splitlines() if ln.startswith("error: ")]
-    assert len(errors) == 1 and "Traceback" not in res.output, res.output
-    for n in needles:
-        assert n in errors[0], errors[0]
 
 
 @pytest.fixture(scope="module")

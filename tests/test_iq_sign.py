@@ -161,3 +161,25 @@ def test_bad_arguments_are_refused_by_name():
         hr.check_iq_sign(h, z=-0.3)
     with pytest.raises(TypeError, match="medum"):
         hr.check_iq_sign(h, medum=hr.Medium.half_space(0.3, 2.5))
+
+
+def test_a_survey_checks_its_first_frame_only(tmp_path, monkeypatch):
+    # One device, one convention: the sign is checked on the frame probed for the
+    # survey's geometry, not again for every frame (it costs about a small frame's image).
+    from holoradar.imaging import iq
+    from holoradar.survey.worker import read_frame
+
+    h = hr.simulate(_scene(True), hr.Aperture.paper(), ONE)
+    _device_file(tmp_path / "scan.npz", h)
+    layout = "i=I,q=Q,units=mm,frequency_unit=GHz"
+    calls = []
+    real = iq.check_iq_sign
+    monkeypatch.setattr(iq, "check_iq_sign", lambda *a, **k: calls.append(1) or real(*a, **k))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IQSignWarning)
+        probe, _ = read_frame(str(tmp_path / "scan.npz"), None, layout)
+        assert len(calls) == 1
+        geometry = hr.survey.FrameGeometry.of(probe)
+        for _ in range(3):
+            read_frame(str(tmp_path / "scan.npz"), geometry, layout)
+    assert len(calls) == 1

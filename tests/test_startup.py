@@ -76,3 +76,21 @@ def test_version_option_states_the_package_version():
 
     result = CliRunner().invoke(main, ["--version"], prog_name="holoradar")
     assert result.output.strip() == f"holoradar, version {holoradar.__version__}"
+
+
+def test_public_names_are_imported_on_first_use_and_all_resolve():
+    # `import holoradar` loads none of its own subpackages (nothing to compile where
+    # bytecode is not cached); each public name resolves on first use, to the object
+    # its module defines, and `from holoradar import *` gives every one of them.
+    out = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import sys
+        import holoradar as hr
+        early = sorted(m for m in sys.modules if m.startswith("holoradar."))
+        from holoradar.imaging.migrate import migrate
+        ok = hr.migrate is migrate and hr.survey.__name__ == "holoradar.survey"
+        ns = {}
+        exec("from holoradar import *", ns)
+        missing = [n for n in hr.__all__ if n not in ns]
+        print(early, ok, missing)
+        """)], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["[]", "True", "[]"], out.stdout

@@ -14,34 +14,103 @@ Examples
 0.42
 """
 
-from . import calibrate, survey, theory
-from ._validate import AliasingWarning
-from .analysis.detect import detect
-from .analysis.oblique_plan import ObliquePlan, plan_oblique
-from .data.hologram import C0, Hologram, Image
-from .data.pose import Pose
-from .data.wideband import apply_calibration, conjugate, remove_mean
-from .imaging.autofocus import AutofocusResult, autofocus
-from .imaging.glare import (
-    FitWarning,
-    GlareWarning,
-    SuppressionReport,
-    estimate_permittivity,
-    suppress_surface,
-)
-from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
-from .imaging.migrate import IlluminationWarning, migrate
-from .imaging.stream import StreamImager
-from .imaging.synthesis import align_phases, synthesize
-from .io import load, save
-from .model.scene import Aperture, Scene
-from .model.simulate import simulate
-from .model.targets import LineTarget, PlanarTarget, PointTarget
-from .physics.dipole import Dipole
-from .physics.medium import Medium, permittivity
-from .physics.parabolic import ParabolicEquation
-from .physics.propagation import AngularSpectrum, Fresnel
-from .physics.sources import GaussianBeam, PlaneWave, PointSource
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # what static checkers and IDEs see
+    from . import calibrate, survey, theory
+    from ._validate import AliasingWarning
+    from .analysis.detect import detect
+    from .analysis.oblique_plan import ObliquePlan, plan_oblique
+    from .data.hologram import C0, Hologram, Image
+    from .data.pose import Pose
+    from .data.wideband import apply_calibration, conjugate, remove_mean
+    from .imaging.autofocus import AutofocusResult, autofocus
+    from .imaging.glare import (
+        FitWarning,
+        GlareWarning,
+        SuppressionReport,
+        estimate_permittivity,
+        suppress_surface,
+    )
+    from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
+    from .imaging.migrate import IlluminationWarning, migrate
+    from .imaging.stream import StreamImager
+    from .imaging.synthesis import align_phases, synthesize
+    from .io import load, save
+    from .model.scene import Aperture, Scene
+    from .model.simulate import simulate
+    from .model.targets import LineTarget, PlanarTarget, PointTarget
+    from .physics.dipole import Dipole
+    from .physics.medium import Medium, permittivity
+    from .physics.parabolic import ParabolicEquation
+    from .physics.propagation import AngularSpectrum, Fresnel
+    from .physics.sources import GaussianBeam, PlaneWave, PointSource
+
+# The public names, each imported from its module on first use (PEP 562): `import
+# holoradar` then costs little more than numpy even where bytecode is not cached (every
+# module compiled afresh), and `hr.migrate` etc. behave as plain attributes.
+_SUBMODULES = ("calibrate", "survey", "theory")
+_NAMES = {
+    "AliasingWarning": "._validate",
+    "AngularSpectrum": ".physics.propagation",
+    "Aperture": ".model.scene",
+    "AutofocusResult": ".imaging.autofocus",
+    "C0": ".data.hologram",
+    "Dipole": ".physics.dipole",
+    "FitWarning": ".imaging.glare",
+    "Fresnel": ".physics.propagation",
+    "GaussianBeam": ".physics.sources",
+    "GlareWarning": ".imaging.glare",
+    "Hologram": ".data.hologram",
+    "IQSignWarning": ".imaging.iq",
+    "IlluminationWarning": ".imaging.migrate",
+    "Image": ".data.hologram",
+    "LineTarget": ".model.targets",
+    "Medium": ".physics.medium",
+    "ObliquePlan": ".analysis.oblique_plan",
+    "ParabolicEquation": ".physics.parabolic",
+    "PlanarTarget": ".model.targets",
+    "PlaneWave": ".physics.sources",
+    "PointSource": ".physics.sources",
+    "PointTarget": ".model.targets",
+    "Pose": ".data.pose",
+    "Scene": ".model.scene",
+    "StreamImager": ".imaging.stream",
+    "SuppressionReport": ".imaging.glare",
+    "align_phases": ".imaging.synthesis",
+    "apply_calibration": ".data.wideband",
+    "autofocus": ".imaging.autofocus",
+    "check_iq_sign": ".imaging.iq",
+    "conjugate": ".data.wideband",
+    "detect": ".analysis.detect",
+    "estimate_permittivity": ".imaging.glare",
+    "iq_convention": ".imaging.iq",
+    "load": ".io",
+    "migrate": ".imaging.migrate",
+    "permittivity": ".physics.medium",
+    "plan_oblique": ".analysis.oblique_plan",
+    "remove_mean": ".data.wideband",
+    "save": ".io",
+    "simulate": ".model.simulate",
+    "suppress_surface": ".imaging.glare",
+    "synthesize": ".imaging.synthesis",
+}
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        value = importlib.import_module(f"{__name__}.{name}")
+    elif name in _NAMES:
+        value = getattr(importlib.import_module(_NAMES[name], __name__), name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # later reads skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
 
 __version__ = "0.1.0"
 

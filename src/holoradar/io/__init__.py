@@ -78,7 +78,7 @@ def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool
 
 
 def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | str | None = None,
-         check: bool = True) -> Hologram | Image:
+         check: bool = True, iq_check: bool = True) -> Hologram | Image:
     """Read a hologram or image: a holoradar NetCDF file, or a user's file of arrays.
 
     Parameters
@@ -99,6 +99,10 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
         whose layout does not declare ``iq_sign``, also check the I/Q sign
         (:func:`~holoradar.imaging.iq.check_iq_sign`, a few milliseconds for a
         16 x 16 array).
+    iq_check : bool
+        With ``check``, the I/Q sign check above (default True). A survey checks its
+        first frame only: every frame of one device shares the convention, and the
+        check would cost as much as imaging a small frame.
 
     Raises
     ------
@@ -160,7 +164,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             device = "iq_sign" not in full.given
     if check and isinstance(obj, Hologram):
         check_plausible(obj, what=src.name)
-        if device:
+        if device and iq_check:
             # A device's own export whose layout does not say its I/Q sign: data in the
             # engineering convention (I - jQ) would image as a blur without a word.
             from ..imaging.iq import warn_if_conjugated

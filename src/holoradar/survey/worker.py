@@ -39,9 +39,10 @@ class Job:
 
 def read_frame(path: str, geometry: FrameGeometry | None,
                layout: Any = None) -> tuple[Hologram | None, str | None]:
-    """``(hologram, None)``, or ``(None, why it cannot be a frame)``."""
+    """``(hologram, None)``, or ``(None, why it cannot be a frame)``. The I/Q sign is
+    checked when probing the first frame (``geometry`` None), not for every frame."""
     try:
-        holo = load(path, layout=layout)
+        holo = load(path, layout=layout, iq_check=geometry is None)
     except ValueError as exc:
         return None, str(exc)
     if not isinstance(holo, Hologram):
