@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from ._validate import AliasingWarning
     from .analysis.detect import detect
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
+    from .app.report import report
     from .data.hologram import C0, Hologram, Image
     from .data.pose import Pose
     from .data.wideband import apply_calibration, conjugate, remove_mean
@@ -91,6 +92,7 @@ _NAMES = {
     "permittivity": ".physics.medium",
     "plan_oblique": ".analysis.oblique_plan",
     "remove_mean": ".data.wideband",
+    "report": ".app.report",
     "save": ".io",
     "simulate": ".model.simulate",
     "suppress_surface": ".imaging.glare",
@@ -156,6 +158,7 @@ __all__ = [
     "permittivity",
     "plan_oblique",
     "remove_mean",
+    "report",
     "save",
     "simulate",
     "suppress_surface",

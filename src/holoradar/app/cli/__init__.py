@@ -124,9 +124,10 @@ def main() -> None:
 
 def _register() -> None:
     from . import batch, calibrate, detect, focus, image, info, misc, plot, process, simulate, view
+    from . import report as report_cli
 
     for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch, detect,
-                   view):
+                   report_cli, view):
         for cmd in module.COMMANDS:
             main.add_command(cmd)
 

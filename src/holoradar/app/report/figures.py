@@ -1,0 +1,249 @@
+"""The report's pictures: plan views at the objects' depths and vertical sections through
+them, the objects outlined and numbered as in the table.
+
+Each picture is ``|E|`` in dB re the brightest pixel of what it shows, over
+``DB_RANGE`` dB (inferno). Objects: a point is a circle of one resolution cell
+across, a line its segment from end to end, an area its outline polygon; each
+carries its number (the table's row + 1) in white on a dark halo, legible on
+any colour of the map. Positions are in cm on the image's axes (a survey's: world
+metres of the frames' positions, in cm).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from matplotlib import patheffects
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Polygon
+
+from ..plotting import _edges, to_png
+from .model import Section
+
+__all__ = ["DB_RANGE", "MAX_PLANES", "Picture", "pictures"]
+
+DB_RANGE = 30.0
+"""dB shown below the brightest pixel."""
+MAX_PLANES = 4
+"""At most this many plan views (and sections) per source: the planes holding most objects."""
+_CM = 100.0
+_COLOUR = "#35e0ff"
+_HALO = [patheffects.withStroke(linewidth=3, foreground="black")]
+
+
+@dataclass
+class Picture:
+    """One embedded figure: its PNG bytes, caption and size in pixels."""
+
+    kind: str
+    caption: str
+    png: bytes
+    width: int
+    height: int
+
+
+def _db(a: np.ndarray) -> np.ndarray:
+    ref = float(np.max(a)) if a.size and np.max(a) > 0 else 1.0
+    return 20 * np.log10(np.maximum(a / ref, 10 ** (-DB_RANGE / 20)))
+
+
+def _cell(section: Section) -> float:
+    cell = section.detection.get("resolution_cell") or []
+    vals = [c for c in cell[:2] if c is not None and math.isfinite(c)]
+    return max(vals) if vals else 0.0
+
+
+def _plane_choice(ranges: np.ndarray, amps: np.ndarray, planes: np.ndarray) -> list[int]:
+    """The planes to draw: those nearest the objects' ranges, most objects first (then the
+    strongest), at most MAX_PLANES, in range order; the brightest plane without objects."""
+    if ranges.size == 0:
+        return []
+    near = [int(np.argmin(np.abs(planes - r))) for r in ranges]
+    score: dict[int, tuple[int, float]] = {}
+    for i, a in zip(near, amps, strict=True):
+        c, best = score.get(i, (0, -np.inf))
+        score[i] = (c + 1, max(best, float(a)))
+    chosen = sorted(score, key=lambda i: score[i], reverse=True)[:MAX_PLANES]
+    return sorted(chosen)
+
+
+def _label(ax: Any, x: float, y: float, n: int, dx: float) -> None:
+    ax.annotate(str(n), (x * _CM, y * _CM), xytext=(x * _CM + dx, y * _CM + dx),
+                color="white", fontsize=11, fontweight="bold", ha="left", va="bottom",
+                path_effects=_HALO, zorder=5)
+
+
+def draw_objects(ax: Any, table: Any, rows: Sequence[int], cell: float, *,
+                 span: float) -> None:
+    """Outline and number the rows ``rows`` of ``table`` on a plan view in cm.
+
+    ``cell`` is the lateral resolution cell (m; a point's circle), ``span`` the
+    view's width (m; sets the labels' offset).
+    """
+    outlines = table.attrs.get("outlines") or {}
+    radius = (cell / 2 if cell > 0 else span / 60) * _CM
+    dx = max(radius * 0.8, span * _CM / 120)
+    for i in rows:
+        r = table.iloc[i]
+        kind = str(r["kind"])
+        if kind == "area" and outlines.get(i):
+            ring = np.asarray(outlines[i], dtype=float) * _CM
+            ax.add_patch(Polygon(ring, closed=True, fill=False, ec=_COLOUR, lw=1.8, zorder=4))
+        elif kind == "line" and all(np.isfinite(float(r.get(k, np.nan)))
+                                    for k in ("x_start", "y_start", "x_end", "y_end")):
+            ax.plot([r["x_start"] * _CM, r["x_end"] * _CM], [r["y_start"] * _CM,
+                    r["y_end"] * _CM], color=_COLOUR, lw=2.2, solid_capstyle="round", zorder=4)
+        else:
+            ax.add_patch(Circle((r["x"] * _CM, r["y"] * _CM), radius, fill=False, ec=_COLOUR,
+                                lw=1.8, zorder=4))
+        _label(ax, float(r["x"]), float(r["y"]), i + 1, dx)
+
+
+def _plan(x: np.ndarray, y: np.ndarray, amp: np.ndarray, title: str, table: Any,
+          rows: Sequence[int], cell: float) -> Figure:
+    """A plan view; a long strip (a survey) is cut into rows stacked one above the other."""
+    wx, wy = float(np.ptp(x)) or 1e-3, float(np.ptp(y)) or 1e-3
+    pieces = max(1, min(12, math.ceil(wx / wy / 5)))
+    edges = np.linspace(float(x[0]), float(x[-1]), pieces + 1)
+    width = 9.0
+    panel_h = min(7.0, max(1.6, (width - 1.6) * min(wy / (wx / pieces), 1.0) + 0.9))
+    fig = Figure(figsize=(width, panel_h * pieces + 0.5), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(pieces, 1))
+    a = _db(amp)
+    for k, ax in enumerate(axes):
+        sel = np.nonzero((x >= edges[k] - 1e-12) & (x <= edges[k + 1] + 1e-12))[0]
+        sel = np.arange(max(sel[0] - 1, 0), min(sel[-1] + 2, x.size)) if sel.size else sel
+        m = ax.pcolormesh(_edges(x[sel]) * _CM, _edges(y) * _CM, a[:, sel], cmap="inferno",
+                          vmin=-DB_RANGE, vmax=0.0, shading="flat")
+        inside = [i for i in rows if x[sel][0] <= table.iloc[i]["x"] <= x[sel][-1]]
+        draw_objects(ax, table, inside, cell, span=float(np.ptp(x[sel])) or wx)
+        ax.set_xlim(_edges(x[sel])[0] * _CM, _edges(x[sel])[-1] * _CM)
+        ax.set_ylim(_edges(y)[0] * _CM, _edges(y)[-1] * _CM)
+        ax.set_aspect("equal")
+        ax.set_ylabel("y (cm)")
+        if k == len(axes) - 1:
+            ax.set_xlabel("x (cm)")
+    fig.colorbar(m, ax=list(axes), label=f"|E| (dB re the brightest pixel; {DB_RANGE:.0f} "
+                                         "dB shown)", shrink=0.9 if pieces == 1 else 0.6)
+    fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def _where(z: float, medium: Any) -> str:
+    if medium is not None and medium.z_interfaces:
+        return f"range {z * _CM:.1f} cm, depth {(z - medium.z_interfaces[0]) * _CM:.1f} cm " \
+               "below the surface"
+    return f"range {z * _CM:.1f} cm from the array"
+
+
+def _section_view(img: Any, vol: np.ndarray, table: Any, rows: Sequence[int], at_y: float,
+                  cell: float, medium: Any, name: str) -> Figure:
+    """An x-range section of |E| at ``y = at_y``, the objects within one cell of it marked."""
+    j = int(np.argmin(np.abs(img.y - at_y)))
+    sec = vol[:, j, :]
+    fig = Figure(figsize=(9.0, 4.2), layout="constrained")
+    ax = fig.subplots()
+    m = ax.pcolormesh(_edges(img.x) * _CM, _edges(img.z) * _CM, _db(sec), cmap="inferno",
+                      vmin=-DB_RANGE, vmax=0.0, shading="flat")
+    ax.invert_yaxis()
+    ax.set_xlabel("x (cm)")
+    ax.set_ylabel("range from the array (cm)")
+    if medium is not None and medium.z_interfaces:
+        zs = float(medium.z_interfaces[0]) * _CM
+        if img.z[0] * _CM <= zs <= img.z[-1] * _CM:
+            ax.axhline(zs, color="c", lw=1, ls="--", label="ground surface")
+            ax.legend(loc="lower right", fontsize=8)
+        sec_ax = ax.secondary_yaxis("right", functions=(lambda v: v - zs, lambda v: v + zs))
+        sec_ax.set_ylabel("depth below the surface (cm)")
+    yj = float(img.y[j])
+    near = [i for i in rows if abs(float(table.iloc[i]["y"]) - yj) <= max(cell, 1e-9)
+            or (str(table.iloc[i]["kind"]) != "point" and _crosses(table.iloc[i], yj))]
+    dx = float(np.ptp(img.x)) * _CM / 100
+    for i in near:
+        r = table.iloc[i]
+        ax.plot(r["x"] * _CM, r["range"] * _CM, marker="o", ms=12, mfc="none", mec=_COLOUR,
+                mew=1.8, zorder=4)
+        ax.annotate(str(i + 1), (r["x"] * _CM, r["range"] * _CM),
+                    xytext=(r["x"] * _CM + dx, r["range"] * _CM - dx), color="white",
+                    fontsize=11, fontweight="bold", path_effects=_HALO, zorder=5)
+    fig.colorbar(m, ax=ax, label="|E| (dB re the section's brightest pixel)")
+    fig.suptitle(f"{name}: section at y = {img.y[j] * _CM:.1f} cm", fontsize=11)
+    return fig
+
+
+def _crosses(r: Any, y: float) -> bool:
+    ys = [float(r.get(k, np.nan)) for k in ("y_start", "y_end")]
+    if all(np.isfinite(ys)):
+        return min(ys) <= y <= max(ys)
+    return False
+
+
+def _picture(kind: str, caption: str, fig: Figure) -> Picture:
+    w, h = fig.get_size_inches()
+    dpi = 100
+    return Picture(kind, caption, to_png(fig, dpi=dpi), round(w * dpi), round(h * dpi))
+
+
+def pictures(section: Section) -> list[Picture]:
+    """The plan views (and, for a volume, the sections) of one source."""
+    table = section.table
+    cell = _cell(section)
+    medium = section.ground.medium
+    if section.kind == "survey":
+        return _survey_pictures(section, cell)
+    img = section.image
+    planes = np.atleast_1d(np.asarray(img.z, dtype=float))
+    vol = np.abs(np.asarray(img.data)).reshape((-1, planes.size, img.y.size, img.x.size))[0]
+    ranges = np.asarray(table["range"], dtype=float) if len(table) else np.zeros(0)
+    amps = np.asarray(table["amplitude_db"], dtype=float) if len(table) else np.zeros(0)
+    chosen = _plane_choice(ranges, amps, planes) or \
+        [int(np.argmax(vol.reshape(planes.size, -1).max(axis=1)))]
+    # every object on the drawn plane nearest its range
+    home = {i: chosen[int(np.argmin([abs(planes[c] - ranges[i]) for c in chosen]))]
+            for i in range(len(table))}
+    out = []
+    for c in chosen:
+        rows = [i for i, h in home.items() if h == c]
+        title = f"{section.name}: plan view at {_where(float(planes[c]), medium)}"
+        if not rows:
+            title += " (no object)"
+        out.append(_picture("plan", title, _plan(img.x, img.y, vol[c], title, table, rows,
+                                                 cell)))
+    if planes.size > 1:
+        for c in chosen:
+            rows = [i for i, h in home.items() if h == c]
+            if not rows:
+                continue
+            best = max(rows, key=lambda i: float(table.iloc[i]["amplitude_db"]))
+            fig = _section_view(img, vol, table, list(range(len(table))),
+                                float(table.iloc[best]["y"]), cell, medium, section.name)
+            out.append(_picture("section", f"{section.name}: vertical section through object "
+                                           f"{best + 1}", fig))
+    return out
+
+
+def _survey_pictures(section: Section, cell: float) -> list[Picture]:
+    from ...survey.mosaic import mosaic
+    from ...survey.store import read_index
+
+    table = section.table
+    planes = np.asarray(read_index(section.store)["z"], dtype=float)
+    ranges = np.asarray(table["range"], dtype=float) if len(table) else np.zeros(0)
+    amps = np.asarray(table["amplitude_db"], dtype=float) if len(table) else np.zeros(0)
+    chosen = _plane_choice(ranges, amps, planes) or [0]
+    home = {i: chosen[int(np.argmin([abs(planes[c] - ranges[i]) for c in chosen]))]
+            for i in range(len(table))}
+    out = []
+    for c in chosen:
+        m = mosaic(section.store, float(planes[c]))
+        rows = [i for i, h in home.items() if h == c]
+        title = f"{section.name}: mosaic at {float(planes[c]) * _CM:.1f} cm from the arrays " \
+                "(survey coordinates)"
+        out.append(_picture("plan", title, _plan(np.asarray(m.x), np.asarray(m.y),
+                                                 np.abs(np.asarray(m.data)), title, table,
+                                                 rows, cell)))
+    return out

@@ -1,0 +1,77 @@
+"""The objects' table as HTML: one row per object, numbered as ``holoradar detect``
+numbers them (row ``i`` of ``hr.detect``'s table is object ``i + 1``).
+
+Each cell shows the value in the column's unit (cm, cm^2, deg, dB) rounded to the
+digits shown in :data:`COLUMNS`, and carries the exact value in ``hr.detect``'s unit
+(metres, m^2, degrees, dB) as ``data-value`` (Python's ``repr`` of the float, which
+reads back to the same double; ``nan`` for a missing value), so that a program can
+read the table back exactly.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from typing import Any
+
+__all__ = ["COLUMNS", "objects_table"]
+
+COLUMNS: list[tuple[str, str, float, int]] = [
+    ("x", "x (cm)", 100.0, 1),
+    ("y", "y (cm)", 100.0, 1),
+    ("range", "range (cm)", 100.0, 1),
+    ("depth", "depth (cm)", 100.0, 1),
+    ("depth_low", "depth 95 % low (cm)", 100.0, 1),
+    ("depth_high", "depth 95 % high (cm)", 100.0, 1),
+    ("length", "length (cm)", 100.0, 1),
+    ("width", "width (cm)", 100.0, 1),
+    ("azimuth_deg", "azimuth (deg)", 1.0, 0),
+    ("area", "area (cm²)", 1e4, 0),
+    ("amplitude_db", "amplitude (dB)", 1.0, 1),
+    ("snr_db", "SNR (dB)", 1.0, 1),
+]
+"""(column of ``hr.detect``'s table, header, factor to the shown unit, decimals shown)."""
+
+
+def _number(v: Any) -> float:
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _cell(col: str, value: Any, factor: float, digits: int) -> str:
+    v = _number(value)
+    shown = "" if not math.isfinite(v) else f"{v * factor:.{digits}f}"
+    return f'<td data-col="{col}" data-value="{html.escape(repr(v))}">{shown}</td>'
+
+
+def objects_table(table: Any, source: str, key: str = "s1") -> str:
+    """The table's HTML (``<table class="objects">``), or a sentence when it is empty.
+
+    ``source`` names the source (``data-source``); ``key`` prefixes the rows' ids
+    (``{key}-object-{n}``).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> df = pd.DataFrame([{"kind": "point", "x": 0.1, "y": -0.02, "range": 0.42}])
+    >>> text = objects_table(df, "a.nc")
+    >>> '<td data-col="x" data-value="0.1">10.0</td>' in text
+    True
+    """
+    if len(table) == 0:
+        return '<p class="none">No object above the threshold.</p>'
+    cols = [c for c in COLUMNS if c[0] in table.columns]
+    frame = "frame" in table.columns
+    head = "".join(f"<th>{html.escape(h)}</th>" for _, h, _, _ in cols)
+    rows = []
+    for i, rec in enumerate(table.to_dict("records")):
+        cells = "".join(_cell(c, rec.get(c), f, d) for c, _, f, d in cols)
+        extra = f'<td data-col="frame">{html.escape(str(rec["frame"]))}</td>' if frame else ""
+        rows.append(f'<tr id="{key}-object-{i + 1}"><td data-col="number">'
+                    f'{i + 1}</td><td data-col="kind">{html.escape(str(rec["kind"]))}</td>'
+                    f"{cells}{extra}</tr>")
+    return (f'<table class="objects" data-source="{html.escape(source)}"><thead><tr>'
+            f'<th>#</th><th>kind</th>{head}{"<th>frame</th>" if frame else ""}</tr></thead>'
+            f'<tbody>{"".join(rows)}</tbody></table>')
