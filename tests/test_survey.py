@@ -164,37 +164,44 @@ def test_rerun_resumes_without_redoing(survey200, tmp_path: Path,
 # (d) a run cut short leaves a readable store; the rerun completes it
 def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    from holoradar.survey import batch as survey_batch
+
     paths, holos = survey200
     frames = paths[:12]
-    real = survey_worker.write_frame
+    # Chunks of 4 frames: the second chunk's images are written, then the run "dies"
+    # before their positions and done flags (a KeyboardInterrupt in the writer).
+    monkeypatch.setattr(survey_batch, "frames_per_chunk", lambda per, n: 4)
+    real = survey_worker.write_frames
     n = [0]
     crashed = []
 
-    def crash_after_image(store, token, slot, data, position):
+    def crash_after_image(store, token, slots, block, positions):
         n[0] += 1
-        if n[0] <= 5:
-            return real(store, token, slot, data, position)
-        # The 6th frame: its image chunk is written, then the process "dies".
+        if n[0] != 2:
+            return real(store, token, slots, block, positions)
         h = survey_store._handles(store, token)
-        h["image"][slot] = np.stack([data.real, data.imag], axis=-1)
-        crashed.append(slot)
+        h["image"][slots[0]:slots[-1] + 1] = block
+        crashed.extend(slots)
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(survey_worker, "write_frame", crash_after_image)
+    monkeypatch.setattr(survey_worker, "write_frames", crash_after_image)
     store = tmp_path / "s.zarr"
     with pytest.raises(KeyboardInterrupt) as stop:
-        hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
-    # Ctrl-C says what the store holds (the command line prints it as its one line)
+        hr.survey.run_batch(frames, store, z=Z, workers=1)
+    assert crashed == [4, 5, 6, 7]
+    # Ctrl-C says what the store holds (the command line prints it as its one line): the
+    # first chunk, and the third if its write had started before the second failed.
     assert isinstance(stop.value, hr.survey.BatchInterrupted)
-    assert (stop.value.stored, stop.value.frames) == (5, 12)
-    assert str(stop.value) == (f"interrupted: 5 of 12 frames are stored in {str(store)!r}; "
-                               "run_batch with the same arguments resumes")
+    stored = int(survey_store.read_index(store)["done"].sum())
+    assert stored in (4, 8) and (stop.value.stored, stop.value.frames) == (stored, 12)
+    assert str(stop.value) == (f"interrupted: {stored} of 12 frames are stored in "
+                               f"{str(store)!r}; run_batch with the same arguments resumes")
     ds = hr.survey.open_survey(store)
-    assert int(ds["done"].sum()) == 5 and not bool(ds["done"][crashed[0]])
-    assert _assert_exact(store, paths, holos).sum() == 5
-    monkeypatch.setattr(survey_worker, "write_frame", real)
-    s = hr.survey.run_batch(frames, store, z=Z, scheduler="synchronous")
-    assert (s["resumed"], s["done"]) == (5, 7)
+    assert int(ds["done"].sum()) == stored and not ds["done"][crashed].any()
+    assert _assert_exact(store, paths, holos).sum() == stored
+    monkeypatch.setattr(survey_worker, "write_frames", real)
+    s = hr.survey.run_batch(frames, store, z=Z, workers=1)
+    assert (s["resumed"], s["done"]) == (stored, 12 - stored)
     assert _assert_exact(store, paths, holos).all()
 
 
@@ -205,7 +212,7 @@ def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
     from holoradar.survey import schedule
 
     paths, holos = survey200
-    real = survey_worker.process_frame
+    real = survey_worker.image_frame
     calls = []
 
     def ctrl_c_during_the_first(*args, **kwargs):
@@ -213,7 +220,7 @@ def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
         schedule._LOCAL_STOP.set()  # what run_tasks does on KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(survey_worker, "process_frame", ctrl_c_during_the_first)
+    monkeypatch.setattr(survey_worker, "image_frame", ctrl_c_during_the_first)
     store = tmp_path / "s.zarr"
     job = survey_worker.Job(str(store), "run", hr.survey.Settings.make(Z, None, "angular", 1),
                             hr.survey.FrameGeometry.of(holos[0]), False)
@@ -222,7 +229,8 @@ def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
     chunk = [(slot, str(p), p.name) for slot, p in zip(slots, paths[:4], strict=True)]
     assert [r["status"] for r in survey_worker.process_chunk(chunk, job)] == ["done"]
     assert len(calls) == 1
-    monkeypatch.setattr(survey_worker, "process_frame", real)
+    assert survey_store.read_index(store)["done"].sum() == 1  # the frame in hand is stored
+    monkeypatch.setattr(survey_worker, "image_frame", real)
     s = hr.survey.run_batch(paths[:4], store, z=Z, scheduler="synchronous")
     assert (s["resumed"], s["done"]) == (1, 3)  # the stop does not outlive its run
 
@@ -415,9 +423,14 @@ def test_refusals(survey200, tmp_path: Path) -> None:
     assert not (tmp_path / "t.zarr").exists()
 
 
-def test_default_local_scheduler_processes(survey200, tmp_path: Path) -> None:
+def test_default_and_dask_local_schedulers(survey200, tmp_path: Path) -> None:
+    """By default a short survey stays in the caller's process (a cluster would take
+    longer to start than the frames to image); Dask's local schedulers still work."""
     paths, holos = survey200
-    s = hr.survey.run_batch(paths[:16], tmp_path / "s.zarr", z=Z)
+    s = hr.survey.run_batch(paths[:16], tmp_path / "d.zarr", z=Z)
+    assert (s["scheduler"], s["workers"], s["done"]) == ("in-process", 1, 16)
+    assert _assert_exact(tmp_path / "d.zarr", paths, holos).all()
+    s = hr.survey.run_batch(paths[:16], tmp_path / "s.zarr", z=Z, scheduler="processes")
     assert s["scheduler"] == "processes" and s["done"] == 16
     assert _assert_exact(tmp_path / "s.zarr", paths, holos).all()
     s = hr.survey.run_batch(paths[:16], tmp_path / "t.zarr", z=Z, scheduler="threads")

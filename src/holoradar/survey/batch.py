@@ -1,4 +1,5 @@
-"""``run_batch``: image every frame of a survey with the same settings, on Dask."""
+"""``run_batch``: image every frame of a survey with the same settings, on one or more
+worker processes (a local cluster started for the run, or Dask's schedulers)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..io.output import check_output
 from ..physics.medium import Medium
 from . import schedule
@@ -17,14 +20,17 @@ from .frames import FrameGeometry
 from .settings import Settings
 from .store import (
     create_store,
+    file_stamp,
     frame_bytes,
+    frames_per_chunk,
     is_survey,
     note_skipped,
     read_index,
     register_frames,
+    remembered_bad,
     stored_settings,
 )
-from .worker import Job, process_chunk, read_frame
+from .worker import Job, drain_writes, process_chunk, read_frame
 
 __all__ = ["BatchInterrupted", "SettingsMismatchError", "run_batch"]
 
@@ -73,9 +79,9 @@ class SettingsMismatchError(ValueError):
 
 def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike[str], *,
               z: float | Sequence[float], medium: Medium | None = None,
-              method: str = "angular", upsample: int = 1, scheduler: str | None = None,
-              strict: bool = False, overwrite: bool = False,
-              progress: bool = False, layout: Any = None,
+              method: str = "angular", upsample: int = 1, workers: int | None = None,
+              scheduler: str | None = None, strict: bool = False, overwrite: bool = False,
+              retry_bad: bool = False, progress: bool = False, layout: Any = None,
               on_start: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """Image every frame of a survey with the same settings into one Zarr store.
 
@@ -84,8 +90,9 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     into its own slot of the store together with its position along the survey
     (the world position of the centre of its element grid: ``pose.center`` for
     the usual centred grids, the centre of the coordinates for the identity
-    pose; :func:`~holoradar.survey.frames.frame_position`). The work runs on
-    Dask; the layout of the store is in :mod:`holoradar.survey.store`.
+    pose; :func:`~holoradar.survey.frames.frame_position`). A task images the
+    frames of whole chunks of the store (several frames a chunk) and writes each
+    chunk once; the layout of the store is in :mod:`holoradar.survey.store`.
 
     Parameters
     ----------
@@ -102,12 +109,20 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         Migration method (:func:`holoradar.migrate`).
     upsample : int
         Output pixels per element pitch.
+    workers : int, optional
+        Worker processes on this machine: 1 images the frames in this process
+        (no Dask); N >= 2 starts a ``dask.distributed.LocalCluster`` of N
+        processes of one thread each for the run (closed at its end). None (the
+        default, with no ``scheduler``): this process images a first chunk of
+        frames, and a cluster of one worker per usable core is started for the
+        rest only if they would take more than :data:`AUTO_CLUSTER_S` seconds
+        here (starting workers costs seconds; a short survey is faster without).
     scheduler : str, optional
-        None: Dask's local ``"processes"`` scheduler (one process per core);
-        ``"threads"``, ``"processes"`` or ``"synchronous"``: that local
-        scheduler; anything else: the address of a ``dask.distributed``
-        scheduler (``"tcp://host:8786"``), whose workers must see the frames and
-        the store at the same paths.
+        Instead of ``workers``: ``"synchronous"`` (this process, as
+        ``workers=1``), ``"threads"`` or ``"processes"`` (Dask's local
+        schedulers), or the address of a running ``dask.distributed`` scheduler
+        (``"tcp://host:8786"``), whose workers must see the frames and the store
+        at the same paths.
     strict : bool
         Stop at the first frame that cannot be imaged (raise ``ValueError``
         naming it); the frames finished before stay in the store. Default
@@ -116,6 +131,11 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         Start a new store even if one exists (the old one is removed once the
         new layout is in place). Default False: an existing store of the same
         settings is resumed: frames marked done are not imaged again.
+    retry_bad : bool
+        Read again the frames an earlier run of this store found bad (damaged,
+        of another geometry...). Default False: such a frame whose file has not
+        changed since (same size and modification time) is skipped with the
+        reason found then, without reading it.
     progress : bool
         Show a progress bar.
     layout : Layout, dict or str, optional
@@ -134,7 +154,10 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         ``done`` (frames imaged by this run), ``resumed`` (frames found done in
         the store and not imaged again), ``skipped`` (list of ``{"name",
         "reason"}``), ``seconds`` (wall time of the run), ``frames`` (distinct
-        frames asked), ``store`` (its path), ``scheduler``, ``workers`` and
+        frames asked), ``store`` (its path), ``scheduler`` (``"in-process"``,
+        ``"local cluster"``, or the scheduler asked), ``workers``, ``remembered``
+        (skipped frames found bad by an earlier run, not read again; their
+        entries in ``skipped`` carry ``"remembered": True``) and
         ``warnings`` (each distinct warning the workers raised, once, as
         ``"Category: message"``), ``bytes_estimated`` (the store's growth at most,
         as given to ``on_start``; 0 when nothing was left to image).
@@ -145,7 +168,8 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         No frames; a bad store path (suffix, folder, equal to a frame, an
         existing folder that is not a survey store); an existing store made
         with other settings (unless ``overwrite``; :class:`SettingsMismatchError`); a
-        bad scheduler; no frame can be imaged; with ``strict``, the first frame
+        bad scheduler or ``workers``, or both given; no frame can be imaged; with
+        ``strict``, the first frame
         that cannot be imaged; the images would not fit on the store's disk
         (checked before any is imaged, against their size before compression).
     BatchInterrupted
@@ -185,7 +209,13 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     """
     t0 = time.perf_counter()
     settings = Settings.make(z, medium, method, upsample)
-    sched = schedule.check_scheduler(scheduler)
+    n_workers = schedule.check_workers(workers)
+    if n_workers is not None and scheduler is not None:
+        raise ValueError(f"give workers (a local cluster started for the run) or scheduler, "
+                         f"not both: got workers={workers!r}, scheduler={scheduler!r}")
+    sched = "auto" if scheduler is None else schedule.check_scheduler(scheduler)
+    if n_workers is not None:
+        sched = "in-process" if n_workers == 1 else "local cluster"
     if isinstance(frames, str | os.PathLike):
         raise ValueError("frames must be a sequence of paths (a list), not one path")
     given = [Path(f) for f in frames]
@@ -203,11 +233,12 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
                          "refusing to touch it (choose another path or remove it)")
 
     # A cluster is reached before anything is written (an unreachable address is an error).
-    client = schedule.connect(sched) if sched not in schedule.LOCAL else None
+    client = schedule.connect(sched) if sched not in (*schedule.LOCAL, *_OWN) else None
     try:
         summary = _run(given, target, settings, sched, client, strict=bool(strict),
                        overwrite=overwrite, exists=exists, progress=progress,
-                       layout=_layout_text(layout), on_start=on_start)
+                       layout=_layout_text(layout), on_start=on_start,
+                       workers=n_workers, retry_bad=bool(retry_bad))
     except KeyboardInterrupt:
         # The workers have stopped (run_tasks): what the store holds now is what a
         # rerun finds. "from None": the interrupted frame's traceback says nothing.
@@ -280,15 +311,25 @@ def _layout_text(layout: Any) -> Any:
     return _as_layout(layout)
 
 
+_OWN = ("auto", "in-process", "local cluster")  # run here, or on a cluster started here
+
+AUTO_CLUSTER_S = 10.0
+"""With ``workers=None``: the least time (s) the frames left after the first chunk would
+take in this process for a local cluster to be started for them. Starting one costs
+2 to 5 s (its processes start and import the imaging code; measured on 2 cores,
+benchmarks/results_batch.json), so below this the run stays in this process."""
+
+
 def _run(given: list[Path], target: Path, settings: Settings, sched: str, client: Any, *,
          strict: bool, overwrite: bool, exists: bool, progress: bool,
          layout: Any = None,
-         on_start: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+         on_start: Callable[[dict[str, Any]], None] | None = None,
+         workers: int | None = None, retry_bad: bool = False) -> dict[str, Any]:
     """The run itself, once the arguments are checked (see :func:`run_batch`)."""
     # Distinct frames, and the checks that need no reading, before anything is written.
     frames_in: list[tuple[Path, str]] = []  # (absolute path, name as given)
     seen: set[Path] = set()
-    skipped: list[dict[str, str]] = []
+    skipped: list[dict[str, Any]] = []
     for p in given:
         key = p.resolve()
         if key in seen:
@@ -301,6 +342,10 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
         else:
             frames_in.append((key, str(p)))
     n_frames = len(seen)
+    # The files' stamps before any is read: a frame found bad is remembered with these, so
+    # a file changed while the run read it is read again by the next run.
+    stamps = {str(k): file_stamp(k) for k, _ in frames_in}
+    read_bad: dict[str, str] = {}  # absolute path -> reason: found bad when read or imaged
 
     fresh = overwrite or not exists  # a new store is laid out
     if not fresh:
@@ -308,11 +353,25 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
         diff = old.differences(settings)
         if diff:
             raise SettingsMismatchError(str(target), diff)
+        known_bad = {} if retry_bad else remembered_bad(target)
+        keep = []
+        for key, name in frames_in:
+            reason = known_bad.get(str(key))
+            if reason is None:
+                keep.append((key, name))
+                continue
+            if strict:
+                raise ValueError(f"frame {name!r}: {reason} (found by an earlier run; strict: "
+                                 "nothing was written; retry_bad reads it again)")
+            skipped.append({"name": name, "reason": reason, "remembered": True})
+            read_bad[str(key)] = reason
+        frames_in = keep
     else:
         found, refused = _reference(frames_in, strict, layout)
         for name, reason in refused:
             skipped.append({"name": name, "reason": reason})
         refused_names = {name for name, _ in refused}
+        read_bad.update({str(k): r for k, n in frames_in for name, r in refused if n == name})
         frames_in = [f for f in frames_in if f[1] not in refused_names]
         if found is None:
             raise ValueError(f"none of the {n_frames} frames can be imaged: "
@@ -321,32 +380,122 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
         # Before the store is laid out: a refused run writes nothing.
         plan = _plan(target, settings, geometry, len(frames_in),
                      reclaimed=_folder_bytes(target) if exists else 0)
-        create_store(target, settings, geometry, replace=exists)
+        create_store(target, settings, geometry, replace=exists,
+                     chunk=frames_per_chunk(frame_bytes(settings, geometry), len(frames_in)))
 
     slots = register_frames(target, [p for p, _ in frames_in])
-    done = read_index(target)["done"]
+    index = read_index(target)
+    done, chunk = index["done"], int(index["group"]["image"].chunks[0])
     todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, frames_in, strict=True)
             if not done[slot]]
     if todo and not fresh:  # (a new store was checked before it was laid out)
         plan = _plan(target, settings, geometry, len(todo))
     if todo and on_start is not None:
         on_start(plan)
-    workers = schedule.cluster_workers(client) if client is not None \
-        else schedule.local_workers(sched)
-    job = Job(str(target), uuid.uuid4().hex, settings, geometry, strict, layout)
-    records = schedule.run_tasks(process_chunk, schedule.split(todo, workers), job, sched,
-                                 progress=progress, client=client) if todo else []
+    token = uuid.uuid4().hex
+    stop_file = target.with_name(f".{target.name}.{token}.stop")
+    # Dask's local pools wait for each task's writes; elsewhere a worker's last chunk is
+    # written while it images its next task, and the writes are waited for at the end.
+    job = Job(str(target), token, settings, geometry, strict, layout,
+              stop_file=str(stop_file) if sched not in schedule.LOCAL else None,
+              drain=sched in ("threads", "processes"))
+    records: list[dict[str, Any]] = []
+    used = {"scheduler": sched, "workers": 1}
+    try:
+        if todo:
+            _execute(todo, chunk, job, sched, client, workers, progress, records, used)
+    finally:
+        # Why frames are missing, kept in the store for `holoradar info` and the next run
+        # (by absolute path), also when the run stops early.
+        by_name = {name: str(k) for k, name in frames_in}
+        for r in records:
+            if r["status"] == "skipped" and r["name"] in by_name:
+                read_bad[by_name[r["name"]]] = r["reason"]
+        reasons = {str(Path(k["name"]).resolve()): k["reason"] for k in skipped}
+        reasons.update(read_bad)
+        note_skipped(target, reasons, [str(p) for p in seen],
+                     {k: v for k, v in stamps.items() if k in read_bad and v is not None})
+        stop_file.unlink(missing_ok=True)
     skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
                 if r["status"] == "skipped"]
-    # Why frames are missing, kept in the store for `holoradar info` (by absolute path).
-    note_skipped(target, {str(Path(k["name"]).resolve()): k["reason"] for k in skipped},
-                 [str(p) for p in seen])
     return {"store": str(target), "frames": n_frames,
             "done": sum(r["status"] == "done" for r in records),
             "resumed": len(frames_in) - len(todo), "skipped": skipped, "seconds": 0.0,
-            "scheduler": sched, "workers": workers,
+            "scheduler": used["scheduler"], "workers": used["workers"],
+            "remembered": sum(bool(k.get("remembered")) for k in skipped),
             "warnings": sorted({w for r in records for w in r.get("warnings", [])}),
             "bytes_estimated": plan["bytes"] if todo else 0}
+
+
+def _execute(todo: list[tuple[int, str, str]], chunk: int, job: Job, sched: str, client: Any,
+             workers: int | None, progress: bool, records: list[dict[str, Any]],
+             used: dict[str, Any]) -> None:
+    """Run the tasks where ``sched`` says; records appended to ``records`` as tasks end.
+    Returns once every write of the run is done (or failed: its error is raised)."""
+    try:
+        _dispatch(todo, chunk, job, sched, client, workers, progress, records, used)
+    finally:
+        drain_writes()  # the writes of this process's tasks
+
+
+def _on_cluster(tasks: list[list[tuple[int, str, str]]], job: Job, client: Any,
+                progress: bool, records: list[dict[str, Any]]) -> None:
+    """The tasks on a ``dask.distributed`` cluster, then every worker's writes waited for."""
+    try:
+        schedule.run_tasks(process_chunk, tasks, job, "cluster", progress=progress,
+                           client=client, into=records)
+    except BaseException:
+        try:
+            client.run(drain_writes)
+        except Exception:  # the run's own error says more
+            pass
+        raise
+    client.run(drain_writes)  # a write's error is raised here
+
+
+def _dispatch(todo: list[tuple[int, str, str]], chunk: int, job: Job, sched: str, client: Any,
+              workers: int | None, progress: bool, records: list[dict[str, Any]],
+              used: dict[str, Any]) -> None:
+    if sched not in _OWN:  # Dask's local schedulers, or a cluster's address
+        n = schedule.cluster_workers(client) if client is not None \
+            else schedule.local_workers(sched)
+        used["workers"] = n
+        if client is not None:
+            _on_cluster(schedule.plan_tasks(todo, chunk), job, client, progress, records)
+        else:
+            schedule.run_tasks(process_chunk, schedule.plan_tasks(todo, chunk), job, sched,
+                               progress=progress, into=records)
+        return
+    tasks = schedule.plan_tasks(todo, chunk)
+    if sched == "in-process":
+        used["scheduler"] = "in-process"
+        schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
+        return
+    n = workers if sched == "local cluster" else schedule.usable_cores()
+    if sched == "auto":
+        # The first chunk here, timed; a cluster only for work that outlasts its start.
+        used["scheduler"] = "in-process"
+        if n < 2 or len(tasks) < 2:
+            schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
+            return
+        schedule.run_here(process_chunk, tasks[:1], job, into=records)
+        # A frame's time here: the median (the first one pays this process's imports).
+        times = [r["seconds"] for r in records if "seconds" in r]
+        per_frame = float(np.median(times)) if times else 0.0
+        tasks = tasks[1:]
+        left = sum(len(t) for t in tasks) * per_frame
+        if left < AUTO_CLUSTER_S:
+            schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
+            return
+        n = min(n, len(tasks))
+    assert n is not None
+    used["scheduler"], used["workers"] = "local cluster", n
+    cluster, own = schedule.local_cluster(n)
+    try:
+        _on_cluster(tasks, job, own, progress, records)
+    finally:
+        own.close()
+        cluster.close()
 
 
 def _skip(skipped: list[dict[str, str]], name: str, reason: str, strict: bool) -> None:

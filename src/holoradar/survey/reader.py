@@ -57,8 +57,8 @@ def open_survey(store: str | os.PathLike[str]) -> Any:
     idx = read_index(Path(store))
     n = idx["n"]
     arr = idx["group"]["image"]
-    image = da.from_array(_Checked(arr, str(store)), chunks=(1, *arr.shape[1:]), name=False,
-                          asarray=True, fancy=False)[:n]
+    image = da.from_array(_Checked(arr, str(store)), chunks=(arr.chunks[0], *arr.shape[1:]),
+                          name=False, asarray=True, fancy=False)[:n]
     per_frame = {k: ("frame", idx[k]) for k in ("frame_x", "frame_y", "frame_z", "finished")}
     coords: dict[str, Any] = {
         "z": ("z", idx["z"], {"units": "m", "long_name": "range of the plane from the aperture"}),

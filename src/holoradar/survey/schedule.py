@@ -1,9 +1,13 @@
-"""Running the tasks on Dask: a local scheduler, or a ``dask.distributed`` cluster.
+"""Running the tasks: in the caller's process, on a local cluster, or on Dask.
 
-No scheduling of our own: the frames are cut into tasks of a few frames each
-and handed to Dask. ``scheduler`` names a local scheduler (``"processes"``,
-``"threads"``, ``"synchronous"``) or is the address of a running
-``dask.distributed`` scheduler (``"tcp://host:8786"``).
+The frames to image are cut into tasks of whole chunks of the store
+(:func:`plan_tasks`: no two tasks write one chunk). ``workers`` (a positive
+integer) runs them in the caller's process (1) or on a
+``dask.distributed.LocalCluster`` of that many single-threaded worker processes
+started for the run (:func:`local_cluster`); ``scheduler`` names one of Dask's
+local schedulers (``"processes"``, ``"threads"``, ``"synchronous"``, the last
+the caller's process) or is the address of a running ``dask.distributed``
+scheduler (``"tcp://host:8786"``).
 """
 
 from __future__ import annotations
@@ -11,12 +15,16 @@ from __future__ import annotations
 import os
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from contextlib import nullcontext
+from pathlib import Path
 from typing import Any
 
-__all__ = ["DEFAULT_SCHEDULER", "LOCAL", "check_scheduler", "cluster_workers", "connect",
-           "local_workers", "process_pool", "run_tasks", "split", "stop_requested"]
+import numpy as np
+
+__all__ = ["DEFAULT_SCHEDULER", "LOCAL", "check_scheduler", "check_workers", "cluster_workers",
+           "connect", "local_cluster", "local_workers", "plan_tasks", "process_pool",
+           "run_here", "run_tasks", "split", "stop_requested", "usable_cores"]
 
 LOCAL = ("processes", "threads", "synchronous")
 DEFAULT_SCHEDULER = "processes"
@@ -64,6 +72,59 @@ def split(items: Sequence[Any], workers: int, *, most: int = 4) -> list[list[Any
     return [list(items[i:i + size]) for i in range(0, len(items), size)]
 
 
+def plan_tasks(todo: Sequence[tuple[int, str, str]], chunk: int, *,
+               least: int = 1) -> list[list[tuple[int, str, str]]]:
+    """Tasks of whole chunks: the frames ``(slot, path, name)`` grouped by the store's chunk
+    (``slot // chunk``), in slot order; neighbouring chunks joined while a task holds
+    fewer than ``least`` frames (a resumed store may leave one or two frames a chunk).
+
+    Examples
+    --------
+    >>> todo = [(s, f"f{s}.nc", f"f{s}.nc") for s in (0, 1, 2, 5, 6, 9)]
+    >>> [[t[0] for t in task] for task in plan_tasks(todo, 4)]
+    [[0, 1, 2], [5, 6], [9]]
+    >>> [[t[0] for t in task] for task in plan_tasks(todo, 4, least=3)]
+    [[0, 1, 2], [5, 6, 9]]
+    """
+    tasks: list[list[tuple[int, str, str]]] = []
+    last = None
+    for item in sorted(todo, key=lambda t: t[0]):
+        group = item[0] // max(1, chunk)
+        if group != last and (not tasks or len(tasks[-1]) >= least):
+            tasks.append([])
+        tasks[-1].append(item)
+        last = group
+    return tasks
+
+
+def check_workers(workers: Any) -> int | None:
+    """``workers`` as an int >= 1 (None stays None: the default); ``ValueError`` otherwise.
+
+    Examples
+    --------
+    >>> check_workers(2), check_workers(None)
+    (2, None)
+    >>> check_workers(0)
+    Traceback (most recent call last):
+    ...
+    ValueError: workers must be a positive integer (the number of worker processes), got 0
+    """
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, int | np.integer) or workers < 1:
+        raise ValueError("workers must be a positive integer (the number of worker "
+                         f"processes), got {workers!r}")
+    return int(workers)
+
+
+def usable_cores() -> int:
+    """Cores this process may run on (its CPU affinity where the platform tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
 def local_workers(name: str) -> int:
     """Workers of a local scheduler (Dask's ``num_workers`` setting, else the cores)."""
     import dask
@@ -73,17 +134,53 @@ def local_workers(name: str) -> int:
     return int(dask.config.get("num_workers", None) or os.cpu_count() or 1)
 
 
+def run_here(func: Callable[..., list[dict[str, Any]]], tasks: list[list[Any]], job: Any, *,
+             progress: bool = False, into: list[dict[str, Any]] | None = None
+             ) -> list[dict[str, Any]]:
+    """``func(task, job)`` for every task in the caller's process, in turn (one worker).
+
+    No Dask: a task's frames are imaged here and its chunks written by a thread of this
+    process. Ctrl-C stops the frame in hand; the task writes what it had imaged and waits
+    for its writes (``func`` does) before KeyboardInterrupt goes on to the caller.
+    ``into``: records are appended there as tasks finish (kept if the run stops).
+    """
+    out: list[dict[str, Any]] = [] if into is None else into
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=sum(len(t) for t in tasks), desc="survey", unit="frame")
+    _LOCAL_STOP.clear()
+    try:
+        for task in tasks:
+            recs = func(task, job)
+            out.extend(recs)
+            if bar is not None:
+                bar.update(len(recs))
+    except KeyboardInterrupt:
+        _LOCAL_STOP.set()
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+    return out
+
+
 def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
-              progress: bool = False, client: Any = None) -> list[dict[str, Any]]:
+              progress: bool = False, client: Any = None,
+              into: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
     """``func(task, job)`` for every task on ``scheduler``; the records of all frames.
 
     A task that raises stops the run: the local schedulers stop handing out
     tasks; on a cluster the remaining ones are cancelled. The exception is
-    raised here. So is KeyboardInterrupt (Ctrl-C), once the local workers have
+    raised here. So is KeyboardInterrupt (Ctrl-C), once the workers have
     stopped: each finishes the frame in hand (``func`` asks :func:`stop_requested`
-    between frames) and starts no other; a second Ctrl-C while they finish
-    terminates worker processes at once.
+    between frames), stores what it imaged, and starts no other; a second Ctrl-C
+    while they finish terminates local worker processes at once (on a cluster:
+    cancels the tasks). ``into``: records are appended there as tasks finish.
     """
+    if scheduler == "synchronous":
+        return run_here(func, tasks, job, progress=progress, into=into)
     if scheduler in LOCAL:
         # Here, not at import: concurrent.futures.process brings in multiprocessing.
         from concurrent.futures.process import BrokenProcessPool
@@ -120,8 +217,23 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
             finally:
                 if scheduler == "threads":
                     pool.shutdown(wait=True)
-        return [r for recs in results for r in recs]
-    from distributed import as_completed
+        recs = [r for rs in results for r in rs]
+        if into is not None:
+            into.extend(recs)
+        return recs
+    return _run_on_cluster(func, tasks, job, client, progress=progress, into=into)
+
+
+def _run_on_cluster(func: Any, tasks: list[list[Any]], job: Any, client: Any, *,
+                    progress: bool, into: list[dict[str, Any]] | None) -> list[dict[str, Any]]:
+    """The tasks on a ``dask.distributed`` cluster (see :func:`run_tasks`).
+
+    Ctrl-C: the run's stop file (``job.stop_file``) is made, which every task checks
+    before each frame (the workers share no memory with the caller, only the store's
+    file system); then every task is waited for: a running one stores the frames it
+    imaged and returns, the others return at once. A second Ctrl-C cancels them.
+    """
+    from distributed import as_completed, wait
 
     futures = client.map(func, tasks, job=job, pure=False)
     bar = None
@@ -129,13 +241,21 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
         from tqdm.auto import tqdm
 
         bar = tqdm(total=sum(len(t) for t in tasks), desc="survey", unit="frame")
-    out: list[dict[str, Any]] = []
+    out: list[dict[str, Any]] = [] if into is None else into
     try:
         for fut in as_completed(futures, loop=client.loop):
             recs = fut.result()  # a task's exception is raised here
             out.extend(recs)
             if bar is not None:
                 bar.update(len(recs))
+    except KeyboardInterrupt:
+        try:
+            if job.stop_file:
+                Path(job.stop_file).touch()
+            wait(futures)
+        except BaseException:
+            client.cancel(futures)
+        raise
     except BaseException:
         client.cancel(futures)
         raise
@@ -143,6 +263,30 @@ def run_tasks(func: Any, tasks: list[list[Any]], job: Any, scheduler: str, *,
         if bar is not None:
             bar.close()
     return out
+
+
+def local_cluster(workers: int) -> tuple[Any, Any]:
+    """A ``dask.distributed.LocalCluster`` of ``workers`` processes of one thread each, and
+    its client, for one run (the caller closes both).
+
+    Each worker imports what a task needs as it starts
+    (:mod:`holoradar.survey.warm`: the imaging code, SciPy's FFT, h5py, Zarr),
+    while the caller lays out the store, and ignores Ctrl-C (the caller stops the
+    tasks). No dashboard; the cluster's own log lines are silenced below errors.
+    """
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR,
+                           preload=["holoradar.survey.warm"])
+    try:
+        client = Client(cluster, set_as_default=False)
+    except BaseException:
+        cluster.close()
+        raise
+    return cluster, client
 
 
 _LOCAL_STOP = threading.Event()
@@ -153,9 +297,12 @@ _WORKER_STOP: list[Any] = []
 """In a worker process: its pool's stop event (set by the caller after Ctrl-C)."""
 
 
-def stop_requested() -> bool:
-    """Whether the run was interrupted (Ctrl-C): a task stops before its next frame."""
-    return _LOCAL_STOP.is_set() or bool(_WORKER_STOP and _WORKER_STOP[0].is_set())
+def stop_requested(stop_file: str | None = None) -> bool:
+    """Whether the run was interrupted (Ctrl-C): a task stops before its next frame.
+
+    ``stop_file``: the run's stop file (a cluster's run), whose existence says so."""
+    return _LOCAL_STOP.is_set() or bool(_WORKER_STOP and _WORKER_STOP[0].is_set()) \
+        or (stop_file is not None and os.path.exists(stop_file))
 
 
 def process_pool(workers: int, *, with_stop: bool = False) -> Any:
@@ -175,7 +322,7 @@ def process_pool(workers: int, *, with_stop: bool = False) -> Any:
         method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
         ctx = mp.get_context(method)
         if method == "forkserver":
-            ctx.set_forkserver_preload(["holoradar.survey.worker", "h5py"])
+            ctx.set_forkserver_preload(["holoradar.survey.warm"])
         stop = ctx.Event()
         entry = (ProcessPoolExecutor(workers, mp_context=ctx, initializer=_start_worker,
                                      initargs=(stop,)), stop)

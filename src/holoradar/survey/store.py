@@ -3,7 +3,8 @@
 Layout (``survey.zarr``; dimensions named, so ``xarray.open_zarr`` reads it)::
 
     image       (frame, z, y, x, iq)  float64 (float32 for complex64 frames); I = iq 0,
-                                      Q = iq 1; one chunk per frame, compressed
+                                      Q = iq 1; chunks of several frames (up to
+                                      4 MiB, :func:`frames_per_chunk`), compressed
                                       (Blosc LZ4, byte shuffle); NaN until written
     z           (z,)     ranges of the planes from the aperture, m
     y, x        (y,) (x,)  pixel offsets from the frame's centre, m (the same for all)
@@ -12,14 +13,20 @@ Layout (``survey.zarr``; dimensions named, so ``xarray.open_zarr`` reads it)::
     done        (frame,) True once the frame's image and position are complete
     frame_name  (frame,) the file's name; frame_path: its absolute path (the key)
     attributes  holoradar_survey (layout version), settings, geometry (JSON), created;
-                skipped (the frames a run could not image, by absolute path: why)
+                skipped (the frames a run could not image, by absolute path: why);
+                skipped_stamp (for those found bad when read or imaged: the file's
+                size and modification time, so that a rerun does not read them again)
 
-A frame's world pixel is ``(position[f, 0] + x, position[f, 1] + y)``
+The per-frame arrays share the image's chunking along ``frame`` (stores written
+before chunked writing hold one frame a chunk, and are resumed as they are). A
+frame's world pixel is ``(position[f, 0] + x, position[f, 1] + y)``
 (:func:`~holoradar.survey.open_survey` calls the columns ``frame_x``,
-``frame_y``, ``frame_z``). Each frame writes its own chunks (the image first,
-``done`` last; Zarr writes each chunk to a temporary file and renames it), so a
-run killed at any moment leaves a store whose frames marked done are complete
-and whose other frames read as NaN. The
+``frame_y``, ``frame_z``). A task owns whole chunks: it writes the images of its
+frames in a chunk with one write, then their positions and times, then their
+``done`` flags, last (Zarr writes each chunk to a temporary file and renames
+it), so a run killed at any moment leaves a store whose frames marked done are
+complete and whose other frames read as NaN (or, if the kill fell between the
+image and ``done`` writes, hold an image a rerun writes again). The
 store itself is laid out in a temporary folder beside the target and renamed
 into place: it exists complete or not at all. Stores written before the images
 were compressed (their chunks plain) are read and resumed as they are: Zarr
@@ -43,8 +50,22 @@ import numpy as np
 from .frames import FrameGeometry
 from .settings import Settings, _show
 
-__all__ = ["LAYOUT", "create_store", "describe_store", "frame_bytes", "is_survey",
-           "note_skipped", "read_index", "register_frames", "write_frame"]
+__all__ = [
+    "CHUNK_BYTES",
+    "LAYOUT",
+    "create_store",
+    "describe_store",
+    "file_stamp",
+    "frame_bytes",
+    "frames_per_chunk",
+    "is_survey",
+    "note_skipped",
+    "read_index",
+    "register_frames",
+    "remembered_bad",
+    "write_frame",
+    "write_frames",
+]
 
 LAYOUT = "1"
 """Version of the store layout (attribute ``holoradar_survey``)."""
@@ -53,6 +74,26 @@ _PER_FRAME = ("position", "finished", "done")  # one chunk per frame
 _NAMES = ("frame_name", "frame_path")                               # written by the driver
 FRAME_ARRAYS = ("image", *_PER_FRAME, *_NAMES)
 _NAME_CHUNK = 1024
+CHUNK_BYTES = 4 * 2**20
+"""Most bytes (before compression) of the images in one chunk: several frames share a
+chunk when theirs are small, so that a small frame is not one tiny file and four tiny
+writes (the per-write cost of Zarr, ~1 ms, was the largest part of the old per-frame
+overhead), while a task (one chunk) stays short enough to balance the workers."""
+_MOST_FRAMES_PER_CHUNK = 64
+
+
+def frames_per_chunk(per_frame: int, n_frames: int) -> int:
+    """Frames per chunk of a new store: as many as fit in :data:`CHUNK_BYTES`, at most
+    64, and at most a sixteenth of the survey (so that even a small survey makes 16
+    tasks, enough for a few workers to share evenly).
+
+    Examples
+    --------
+    >>> frames_per_chunk(571536, 120), frames_per_chunk(32768, 200), frames_per_chunk(2**24, 9)
+    (7, 13, 1)
+    """
+    return max(1, min(_MOST_FRAMES_PER_CHUNK, CHUNK_BYTES // max(1, per_frame),
+                      -(-n_frames // 16)))
 
 
 def _image_codecs() -> list[Any]:
@@ -95,8 +136,9 @@ def pixel_offsets(n: int, step: float) -> np.ndarray:
 
 
 def create_store(target: Path, settings: Settings, geometry: FrameGeometry, *,
-                 replace: bool = False) -> None:
-    """Lay out an empty survey store at ``target`` (replacing an old one if ``replace``).
+                 replace: bool = False, chunk: int = 1) -> None:
+    """Lay out an empty survey store at ``target`` (replacing an old one if ``replace``),
+    its per-frame arrays in chunks of ``chunk`` frames (:func:`frames_per_chunk`).
 
     Examples
     --------
@@ -131,7 +173,8 @@ def create_store(target: Path, settings: Settings, geometry: FrameGeometry, *,
             a.attrs.update(attrs)
             return a
 
-        arr("image", (0, nz, oy, ox, 2), (1, nz, oy, ox, 2), real, ("frame", "z", "y", "x", "iq"),
+        k = max(1, int(chunk))
+        arr("image", (0, nz, oy, ox, 2), (k, nz, oy, ox, 2), real, ("frame", "z", "y", "x", "iq"),
             np.nan, long_name="reconstructed field, I (iq = 0) and Q (iq = 1)", units="1")
         step = (geometry.pitch[0] / settings.upsample, geometry.pitch[1] / settings.upsample)
         for name, values, what in (
@@ -141,11 +184,11 @@ def create_store(target: Path, settings: Settings, geometry: FrameGeometry, *,
             a = arr(name, (values.size,), (values.size,), np.float64, (name,), np.nan,
                     long_name=what, units="m")
             a[:] = values
-        arr("position", (0, 3), (1, 3), np.float64, ("frame", "xyz"), np.nan,
+        arr("position", (0, 3), (k, 3), np.float64, ("frame", "xyz"), np.nan,
             long_name="world position (x, y, z) of the frame's centre", units="m")
-        arr("finished", (0,), (1,), np.float64, ("frame",), np.nan,
+        arr("finished", (0,), (k,), np.float64, ("frame",), np.nan,
             long_name="when the frame was written (UTC)", units="s since 1970-01-01")
-        arr("done", (0,), (1,), bool, ("frame",), False,
+        arr("done", (0,), (k,), bool, ("frame",), False,
             long_name="the frame's image and position are complete")
         arr("frame_name", (0,), (_NAME_CHUNK,), str, ("frame",), "",
             long_name="file name of the frame")
@@ -284,15 +327,52 @@ def _handles(store: str, token: str) -> dict[str, Any]:
 def write_frame(store: str, token: str, slot: int, data: np.ndarray,
                 position: tuple[float, float, float]) -> None:
     """Write one frame's complex image ``data`` (nz, ny', nx') and position, then mark it done."""
+    write_frames(store, token, [slot], as_block([data], _handles(store, token)["image"].dtype),
+                 [position])
+
+
+def as_block(images: Sequence[np.ndarray], real: Any) -> np.ndarray:
+    """Complex images (each nz, ny', nx') as one ``(k, nz, ny', nx', 2)`` block of I and Q
+    in the store's ``real`` dtype (the parts copied, no arithmetic)."""
+    block = np.empty((len(images), *np.shape(images[0]), 2), dtype=real)
+    for j, data in enumerate(images):
+        block[j, ..., 0] = data.real
+        block[j, ..., 1] = data.imag
+    return block
+
+
+def chunk_of(store: str, token: str) -> int:
+    """Frames per chunk of the store's per-frame arrays (1 for stores made before)."""
+    return int(_handles(store, token)["image"].chunks[0])
+
+
+def write_frames(store: str, token: str, slots: Sequence[int], block: np.ndarray,
+                 positions: Sequence[tuple[float, float, float]]) -> None:
+    """Write the images ``block`` (k, nz, ny', nx', 2) of the frames in ``slots`` (k
+    distinct slots, ascending) and their positions, then mark them done.
+
+    The caller owns the chunks these slots lie in (no other task writes them). Each
+    array is written once for all the slots (one write per chunk touched): images
+    first, then positions and times, ``done`` last, so a frame marked done is
+    complete whatever stops the run.
+    """
+    if not len(slots):
+        return
     h = _handles(store, token)
-    img = h["image"]
-    block = np.empty((*data.shape, 2), dtype=img.dtype)
-    block[..., 0] = data.real
-    block[..., 1] = data.imag
-    img[slot] = block
-    h["position"][slot] = np.asarray(position, np.float64)
-    h["finished"][slot] = time.time()
-    h["done"][slot] = True  # last: done means complete
+    idx = np.asarray(slots, dtype=np.intp)
+    lo, hi = int(idx[0]), int(idx[-1]) + 1
+    run = hi - lo == idx.size  # contiguous slots: a plain slice (whole chunks unread)
+
+    def put(arr: Any, values: np.ndarray) -> None:
+        if run:
+            arr[lo:hi] = values
+        else:
+            arr.oindex[idx] = values
+
+    put(h["image"], block)
+    put(h["position"], np.asarray(positions, np.float64).reshape(idx.size, 3))
+    put(h["finished"], np.full(idx.size, time.time()))
+    put(h["done"], np.ones(idx.size, bool))  # last: done means complete
 
 
 @_damaged_as_value_error
@@ -322,23 +402,59 @@ def read_index(target: Path) -> dict[str, Any]:
     return out
 
 
+def file_stamp(path: str | os.PathLike[str]) -> list[int] | None:
+    """A file's ``[size, modification time in ns]``, or None if it cannot be seen."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return [int(st.st_size), int(st.st_mtime_ns)]
+
+
 @_damaged_as_value_error
-def note_skipped(target: Path, skipped: dict[str, str], tried: Sequence[str]) -> None:
-    """Record in the store's ``skipped`` attribute why frames could not be imaged.
+def note_skipped(target: Path, skipped: dict[str, str], tried: Sequence[str],
+                 stamps: dict[str, list[int]] | None = None) -> None:
+    """Record in the store's attributes why frames could not be imaged.
 
     ``skipped`` maps the absolute path of each frame this run skipped to the reason;
     ``tried`` lists the absolute paths of every frame this run was given: their old
     entries are replaced by this run's outcome (a frame imaged since loses its
-    entry). The attribute is rewritten only when it changes.
+    entry). ``stamps`` maps the paths of the frames found bad when read or imaged to
+    their file's :func:`file_stamp`: while the file keeps that stamp, a rerun skips it
+    without reading it (:func:`remembered_bad`). The attributes are rewritten only when
+    they change.
     """
     import zarr
 
     g = zarr.open_group(str(target), mode="r+")
+    gone = set(tried)
     old = {str(k): str(v) for k, v in dict(g.attrs.get("skipped", {}) or {}).items()}
-    new = {k: v for k, v in old.items() if k not in set(tried)}
+    old_st = {str(k): [int(u) for u in v]
+              for k, v in dict(g.attrs.get("skipped_stamp", {}) or {}).items()}
+    new = {k: v for k, v in old.items() if k not in gone}
     new.update(skipped)
+    new_st = {k: v for k, v in old_st.items() if k not in gone}
+    new_st.update({k: list(v) for k, v in (stamps or {}).items() if k in skipped})
+    changed = {}
     if new != old:
-        g.attrs["skipped"] = new
+        changed["skipped"] = new
+    if new_st != old_st:
+        changed["skipped_stamp"] = new_st
+    if changed:
+        g.attrs.update(changed)
+
+
+@_damaged_as_value_error
+def remembered_bad(target: Path) -> dict[str, str]:
+    """The frames earlier runs found bad when reading or imaging them, and whose file has
+    not changed since (same size and modification time): absolute path -> reason."""
+    import zarr
+
+    attrs = zarr.open_group(str(target), mode="r").attrs
+    reasons = {str(k): str(v) for k, v in dict(attrs.get("skipped", {}) or {}).items()}
+    stamps = dict(attrs.get("skipped_stamp", {}) or {})
+    return {p: reasons[p] for p, st in stamps.items()
+            if p in reasons and file_stamp(p) == [int(u) for u in st]}
 
 
 @_damaged_as_value_error
@@ -395,11 +511,12 @@ def describe_store(target: Path) -> dict[str, Any]:
     not_stored += [{"name": Path(p).name, "path": p, "reason": r}
                    for p, r in skipped.items() if p not in known]
     plain = not image.compressors
-    full = int(np.prod(image.shape[1:])) * image.dtype.itemsize
+    per_chunk = int(image.chunks[0])  # frames a chunk holds (1 in stores made before)
+    full = per_chunk * int(np.prod(image.shape[1:])) * image.dtype.itemsize
     damaged = []
     for i in np.nonzero(done)[0]:
         chunk = Path(target, "image", *image.metadata.encode_chunk_key(
-            (int(i), *([0] * (image.ndim - 1)))).split("/"))
+            (int(i) // per_chunk, *([0] * (image.ndim - 1)))).split("/"))
         size = chunk.stat().st_size if chunk.is_file() else None
         reason = ("marked done but its image chunk is missing" if size is None else
                   f"its image chunk holds {size} of {full} bytes" if plain and size != full

@@ -1,14 +1,20 @@
-"""The work of one task: read frames, image them, write them to the store.
+"""The work of one task: read frames, image them, write them to the store a chunk at a time.
 
-This runs on Dask workers (threads, processes or a cluster's machines): it
-needs the frames' files and the store at the same paths as the caller.
+This runs in the caller's process (one worker) or on Dask workers (a local
+cluster's processes, or a cluster's machines): it needs the frames' files and
+the store at the same paths as the caller. A task holds the frames of whole
+chunks of the store (:func:`~holoradar.survey.schedule.plan_tasks`), so no two
+tasks write the same chunk; each chunk's images are written with one write, by a
+thread of the worker's own while it images the next frames.
 """
 
 from __future__ import annotations
 
+import threading
 import time
 import warnings
 from collections.abc import Sequence
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,14 +26,22 @@ from ..io import load
 from .frames import FrameGeometry, frame_position
 from .schedule import stop_requested
 from .settings import Settings
-from .store import write_frame
+from .store import as_block, chunk_of, write_frames
 
-__all__ = ["Job", "process_chunk", "process_frame"]
+__all__ = ["Job", "drain_writes", "image_frame", "process_chunk", "read_frame", "warm"]
 
 
 @dataclass(frozen=True)
 class Job:
-    """What every task of one run shares (pickled to the workers)."""
+    """What every task of one run shares (pickled to the workers).
+
+    ``stop_file``: a path whose existence asks the tasks to stop after the frame in
+    hand (a run on a cluster, whose workers share no memory with the caller).
+    ``drain``: each task waits for its own writes before it returns (True); False
+    leaves a task's last chunk writing while the worker's next task images its
+    frames, and the caller waits for every worker's writes (:func:`drain_writes`)
+    before it counts or reports the store.
+    """
 
     store: str
     token: str
@@ -35,6 +49,8 @@ class Job:
     geometry: FrameGeometry
     strict: bool
     layout: Any = None
+    stop_file: str | None = None
+    drain: bool = True
 
 
 def read_frame(path: str, geometry: FrameGeometry | None,
@@ -57,24 +73,27 @@ def read_frame(path: str, geometry: FrameGeometry | None,
     return (None, problem) if problem else (holo, None)
 
 
-def process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
-    """Image one frame into its slot; a record ``{"name", "status", "warnings", ...}``.
+def image_frame(path: str, name: str, job: Job) -> tuple[dict[str, Any], Any]:
+    """Read and image one frame: ``(record, (image data, position))``, or ``(record,
+    None)`` for a frame that cannot be imaged.
 
-    ``status`` is ``"done"`` or ``"skipped"`` (with a ``reason``); with
-    ``job.strict`` a frame that cannot be imaged raises ``ValueError`` instead.
-    Warnings are returned in the record (a worker's own output is not the
-    user's console): each once, as ``"Category: message"``.
+    The record is ``{"name", "status", "warnings", ...}``: ``status`` ``"done"`` (with
+    ``seconds``) or ``"skipped"`` (with a ``reason``); with ``job.strict`` a frame that
+    cannot be imaged raises ``ValueError`` instead. Warnings are returned in the record
+    (a worker's own output is not the user's console): each once, as ``"Category:
+    message"``. Nothing is written here (:func:`process_chunk` writes).
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        rec = _process_frame(slot, path, name, job)
+        rec, result = _image_frame(path, name, job)
     rec["warnings"] = sorted({f"{w.category.__name__}: {w.message}" for w in caught})
-    return rec
+    return rec, result
 
 
-def _process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
+def _image_frame(path: str, name: str, job: Job) -> tuple[dict[str, Any], Any]:
     t0 = time.perf_counter()
     holo, problem = read_frame(path, job.geometry, job.layout)
+    result = None
     if holo is not None:
         s = job.settings
         try:
@@ -87,21 +106,132 @@ def _process_frame(slot: int, path: str, name: str, job: Job) -> dict[str, Any]:
             if img.data.shape != want:
                 problem = f"its image has shape {img.data.shape}, the survey's {want}"
             else:
-                write_frame(job.store, job.token, slot, img.data, frame_position(holo))
+                result = (img.data, frame_position(holo))
     if problem is not None:
         if job.strict:
             raise ValueError(f"frame {name!r}: {problem} (strict: the run stops; the frames "
                              "finished so far are in the store)")
-        return {"name": name, "status": "skipped", "reason": problem}
-    return {"name": name, "status": "done", "seconds": time.perf_counter() - t0}
+        return {"name": name, "status": "skipped", "reason": problem}, None
+    return {"name": name, "status": "done", "seconds": time.perf_counter() - t0}, result
+
+
+class _Writer:
+    """Writes a worker's finished chunks on a thread of its own, one at a time, while the
+    worker images the next frames (compressing and writing files release the GIL).
+
+    At most one write waits behind the one running, so at most two chunks of images
+    are held in memory. :meth:`drain` waits for all and raises a write's error.
+    """
+
+    def __init__(self, store: str, token: str) -> None:
+        self.store, self.token = store, token
+        self.pending: list[Future[None]] = []
+
+    def submit(self, slots: list[int], images: list[np.ndarray],
+               positions: list[tuple[float, float, float]]) -> None:
+        if not slots:
+            return
+        while len(self.pending) > 1:
+            self.pending.pop(0).result()
+        real = np.float32 if images[0].dtype == np.complex64 else np.float64
+        block = as_block(images, real)  # here: the worker's thread is the one with time
+        fut: Future[None] = Future()
+
+        def run() -> None:
+            try:
+                write_frames(self.store, self.token, slots, block, positions)
+            except BaseException as exc:  # handed to the task that waits on it
+                fut.set_exception(exc)
+            else:
+                fut.set_result(None)
+
+        threading.Thread(target=run, name="holoradar-survey-writer", daemon=True).start()
+        self.pending.append(fut)
+
+    def drain(self) -> None:
+        while self.pending:
+            self.pending.pop(0).result()
+
+
+_WRITERS: dict[tuple[str, str], _Writer] = {}  # this process's writer of a run
+
+
+def _writer(store: str, token: str) -> _Writer:
+    key = (store, token)
+    w = _WRITERS.get(key)
+    if w is None:
+        drain_writes()  # another run's writes (one run at a time per process)
+        w = _WRITERS[key] = _Writer(store, token)
+    return w
+
+
+def drain_writes() -> int:
+    """Wait for this process's pending chunk writes (of any run); raise a write's error.
+
+    Returns the number of runs whose writers were drained. Called by the caller after a
+    run's tasks (in each worker of a cluster: ``client.run(drain_writes)``).
+    """
+    n = 0
+    while _WRITERS:
+        _, w = _WRITERS.popitem()
+        w.drain()
+        n += 1
+    return n
 
 
 def process_chunk(chunk: Sequence[tuple[int, str, str]], job: Job) -> list[dict[str, Any]]:
-    """:func:`process_frame` on each ``(slot, path, name)`` of a task, in turn; after
-    Ctrl-C (:func:`~holoradar.survey.schedule.stop_requested`) no further frame."""
-    out = []
-    for slot, path, name in chunk:
-        if stop_requested():  # the run was interrupted: leave the rest to a rerun
-            break
-        out.append(process_frame(slot, path, name, job))
+    """Image the frames ``(slot, path, name)`` of a task in turn, and store them.
+
+    The frames' images are gathered per chunk of the store and each chunk written once
+    (images, positions and times, then the ``done`` flags), on a thread that runs while
+    the next frames are imaged. After Ctrl-C
+    (:func:`~holoradar.survey.schedule.stop_requested`), or when a frame stops the run
+    (``strict``) or anything raises, no further frame is started: the frames imaged so
+    far are written, the writes waited for, and only then the task returns or raises.
+    Records are as :func:`image_frame`'s.
+    """
+    out: list[dict[str, Any]] = []
+    if not chunk:
+        return out
+    per = chunk_of(job.store, job.token)
+    writer = _writer(job.store, job.token)
+    group = -1
+    slots: list[int] = []
+    images: list[np.ndarray] = []
+    positions: list[tuple[float, float, float]] = []
+    ok = False
+    try:
+        for slot, path, name in chunk:
+            if stop_requested(job.stop_file):  # the run was interrupted: leave the rest
+                break
+            if slot // per != group:  # a new chunk of the store: the last one is complete
+                writer.submit(slots, images, positions)
+                slots, images, positions = [], [], []
+                group = slot // per
+            rec, result = image_frame(path, name, job)
+            out.append(rec)
+            if result is not None:
+                slots.append(slot)
+                images.append(result[0])
+                positions.append(result[1])
+        ok = True
+    finally:
+        # Whatever ended the task (its last frame, Ctrl-C, a strict stop): what was imaged
+        # is handed to the writer; waited for here unless the caller drains later.
+        try:
+            writer.submit(slots, images, positions)
+        finally:
+            if job.drain or not ok or stop_requested(job.stop_file):
+                writer.drain()
     return out
+
+
+def warm() -> None:
+    """Import what a task needs (a worker's first frame then costs what the others do):
+    holoradar's imaging and readers, SciPy's FFT (0.3 s or more of imports on the first
+    migrate), h5py and Zarr. Run once per worker process as it starts."""
+    import h5py  # noqa: F401
+    import scipy.fft  # noqa: F401
+    import zarr  # noqa: F401
+
+    from ..physics import propagation  # noqa: F401
