@@ -216,7 +216,10 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
         else:
             from ..cli.common import read_hologram
 
-            holo = read_hologram(Path(hologram), req.layout, req.check)
+            try:
+                holo = read_hologram(Path(hologram), req.layout, req.check)
+            except ValueError as exc:
+                raise ValueError(f"{n['hologram']}: {exc}") from None
         fit_medium = medium
         if holo.pose.is_level:
             holo, fit_medium = _level(holo, medium)
@@ -224,7 +227,8 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
                          f"give the hologram {name} was imaged from, or {n['z']} to search "
                          "one plane from the image alone")
     if req.z is not None:
-        img = img.plane(_one_plane(req.z, planes, req, name)) if img.has_z_axis else img
+        plane = _one_plane(req.z, planes, req, name)
+        img = img.plane(plane) if img.has_z_axis else img
     elif volume and detections is None:
         raise ValueError(f"{name} is a volume of {planes.size} planes: give {n['hologram']} "
                          f"(the hologram it was imaged from: objects fitted in 3-D) or {n['z']} "
