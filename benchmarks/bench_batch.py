@@ -1,25 +1,31 @@
-"""Survey throughput on Dask: frames/s with 1 and 2 workers, and the cost per frame
-above a bare ``migrate``.
+"""Survey throughput: ``run_batch`` with 1 and 2 workers against a plain loop of
+``load`` + ``migrate`` over the same files, in one run.
 
-``N`` frames of ``SIZE`` x ``SIZE`` elements (random fields, complex128, 1 cm
-pitch at 9.9 GHz, placed along x) are saved as NetCDF files and imaged onto
-``PLANES`` planes by :func:`holoradar.survey.run_batch` into a fresh Zarr store:
+For each case (by default 200 frames of 32 x 32 elements imaged on 9 planes at
+``upsample=2``, 63 x 63 pixels a plane, and 100 frames of 128 x 128 on 9 planes
+at ``upsample=1``; random fields, complex128, 1 cm pitch at 9.9 GHz, placed
+along x), the frames are saved as NetCDF files and timed, interleaved round by
+round (a shared machine's other load then weighs on all alike; medians of
+``REPEAT`` rounds):
 
-* on a ``dask.distributed.LocalCluster`` of 1 and of 2 worker processes (one
-  thread each; the cluster is started before the clock, the store's creation is
-  timed), throughput and the ratio 2 workers / 1 worker;
-* on Dask's local schedulers (``synchronous``, ``threads``, ``processes``, the
-  last the default): the first call (which starts the process pool kept for the
-  session) and the fastest of the next ``REPEAT``;
-* against the bare work: ``migrate`` alone on the holograms in memory, and
-  ``load`` + ``migrate`` in a plain loop.
+* ``bare``: ``migrate`` alone on the holograms in memory;
+* ``loop``: ``migrate(load(path))`` over the files, nothing stored (the floor a
+  batch is measured against);
+* ``batch1``: ``run_batch(..., workers=1)`` into a fresh store (this process);
+* ``batch2``: ``run_batch(..., workers=2)``, the local cluster started for the run
+  and closed after it, as ``holoradar batch --workers 2`` does: its start counts;
+* ``batch2_warm``: on a ``LocalCluster`` of 2 workers started before the clock
+  (its address as ``scheduler``): the steady throughput of two workers.
 
-The per-frame overhead is (batch time per frame with 1 worker) - (bare migrate
-per frame), also as a ratio; it is broken down into reading (``load``), and the
-rest (store writes, Dask). Each case runs ``REPEAT`` times; the fastest counts.
+Then cold, once each, in fresh Python processes (imports, first FFTs and the
+cluster's start count): the loop, ``workers=1`` and ``workers=2``.
 
-Run: ``.venv/bin/python benchmarks/bench_batch.py [--frames N] [--size N]
-[--planes N]`` (writes results_batch.json beside this file).
+Ratios are batch / loop per frame (1.0: as fast as the loop; 0.5: twice as
+fast). ``os.getloadavg()`` is recorded before and after: the machine is shared,
+and other jobs' load slows the two-worker cases most.
+
+Run: ``.venv/bin/python benchmarks/bench_batch.py [--quick]`` (writes
+results_batch.json beside this file).
 """
 
 from __future__ import annotations
@@ -29,6 +35,8 @@ import json
 import os
 import platform
 import shutil
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -39,12 +47,15 @@ import holoradar as hr
 
 F0 = 9.9e9
 PITCH = 0.01
-REPEAT = 3
+REPEAT = 5
+CASES = ({"frames": 200, "size": 32, "planes": 9, "upsample": 2},
+         {"frames": 100, "size": 128, "planes": 9, "upsample": 1})
 
 
 def make_frames(folder: Path, n: int, size: int) -> tuple[list[Path], list[hr.Hologram]]:
     rng = np.random.default_rng(0)
     x = (np.arange(size) - (size - 1) / 2) * PITCH
+    folder.mkdir(parents=True, exist_ok=True)
     paths, holos = [], []
     for i in range(n):
         data = rng.standard_normal((size, size)) + 1j * rng.standard_normal((size, size))
@@ -54,91 +65,134 @@ def make_frames(folder: Path, n: int, size: int) -> tuple[list[Path], list[hr.Ho
     return paths, holos
 
 
-def best_of(fn, repeat: int = REPEAT) -> float:
-    best = np.inf
+def timed(fn) -> tuple[float, float]:
+    """Wall and CPU (this process, all its threads) seconds of ``fn()``."""
+    c0, t0 = time.process_time(), time.perf_counter()
+    fn()
+    return time.perf_counter() - t0, time.process_time() - c0
+
+
+_COLD = """
+import sys, time
+t0 = time.perf_counter()
+import numpy as np
+import holoradar as hr
+mode, listing, store, planes, upsample = sys.argv[1:6]
+paths = open(listing).read().split()
+z = list(np.linspace(0.2, 0.4, int(planes)))
+if mode == "loop":
+    for p in paths:
+        hr.migrate(hr.load(p), z, upsample=int(upsample))
+else:
+    s = hr.survey.run_batch(paths, store, z=z, upsample=int(upsample), workers=int(mode))
+    assert s["done"] == len(paths), s
+print(time.perf_counter() - t0)
+"""
+
+
+def cold(mode: str, paths: list[Path], work: Path, planes: int, upsample: int) -> float:
+    """Seconds of a fresh Python process imaging the frames (imports included)."""
+    listing = work / "frames.txt"
+    listing.write_text("\n".join(map(str, paths)))
+    store = work / f"cold_{mode}.zarr"
+    code = "if __name__ == '__main__':\n" + "\n".join("    " + ln for ln in
+                                                    _COLD.strip().splitlines())
+    out = subprocess.run([sys.executable, "-c", code, mode, str(listing), str(store),
+                          str(planes), str(upsample)], capture_output=True, text=True,
+                         check=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
+    shutil.rmtree(store, ignore_errors=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
+    n, size, planes, up = case["frames"], case["size"], case["planes"], case["upsample"]
+    paths, holos = make_frames(work / f"f{size}", n, size)
+    z = list(np.linspace(0.2, 0.4, planes))
+    k = [0]
+
+    def batch(**kw) -> None:
+        k[0] += 1
+        store = work / f"s{k[0]}.zarr"
+        s = hr.survey.run_batch(paths, store, z=z, upsample=up, **kw)
+        assert s["done"] == n and not s["skipped"], s
+        shutil.rmtree(store, ignore_errors=True)
+
+    for h in holos[:3]:
+        hr.migrate(h, z, upsample=up)  # warm this process (imports, FFT plans)
+    # Bit for bit: the stored images are the loop's (checked on a few frames).
+    store = work / "check.zarr"
+    hr.survey.run_batch(paths[:20], store, z=z, upsample=up, workers=1)
+    for i in (0, 7, 19):
+        assert np.array_equal(hr.survey.frame_image(store, i).data,
+                              hr.migrate(hr.load(paths[i]), z, upsample=up).data)
+    shutil.rmtree(store)
+    batch(scheduler=cluster_address)  # the warm cluster's workers: imports done
+    cases = {
+        "bare": lambda: [hr.migrate(h, z, upsample=up) for h in holos],
+        "loop": lambda: [hr.migrate(hr.load(p), z, upsample=up) for p in paths],
+        "batch1": lambda: batch(workers=1),
+        "batch2": lambda: batch(workers=2),
+        "batch2_warm": lambda: batch(scheduler=cluster_address),
+    }
+    wall: dict[str, list[float]] = {c: [] for c in cases}
+    cpu: dict[str, list[float]] = {c: [] for c in cases}
+    load = [os.getloadavg()[0]]
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+        for name, fn in cases.items():
+            w, c = timed(fn)
+            wall[name].append(w)
+            cpu[name].append(c)
+        load.append(os.getloadavg()[0])
+    med = {c: float(np.median(v)) / n for c, v in wall.items()}
+    res = {**case, "pixels": [planes, up * (size - 1) + 1, up * (size - 1) + 1],
+           "ms_per_frame": {c: 1e3 * v for c, v in med.items()},
+           "ms_per_frame_all": {c: [1e3 * w / n for w in v] for c, v in wall.items()},
+           "cpu_ms_per_frame_this_process": {c: 1e3 * float(np.median(v)) / n
+                                             for c, v in cpu.items()},
+           "ratio_to_loop": {c: med[c] / med["loop"] for c in ("batch1", "batch2",
+                                                               "batch2_warm")},
+           "loadavg_1min": load}
+    res["cold_s"] = {m: cold(m, paths, work, planes, up) for m in ("loop", "1", "2")}
+    res["cold_ratio_to_loop"] = {m: res["cold_s"][m] / res["cold_s"]["loop"]
+                                 for m in ("1", "2")}
+    res["loadavg_1min"].append(os.getloadavg()[0])
+    return res
 
 
 def main() -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--frames", type=int, default=200)
-    ap.add_argument("--size", type=int, default=32)
-    ap.add_argument("--planes", type=int, default=2)
+    ap.add_argument("--quick", action="store_true", help="2 rounds, a quarter of the frames")
     ap.add_argument("--out", default=str(Path(__file__).with_name("results_batch.json")))
     args = ap.parse_args()
     from distributed import LocalCluster
 
-    z = list(np.linspace(0.2, 0.4, args.planes))
+    repeat = 2 if args.quick else REPEAT
+    cases = [{**c, "frames": c["frames"] // 4} for c in CASES] if args.quick else CASES
     work = Path(tempfile.mkdtemp(prefix="bench_batch_"))
+    res: dict = {"machine": f"{platform.machine()}, {os.cpu_count()} cores, "
+                            f"{platform.python_implementation()} {platform.python_version()}",
+                 "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                 "repeat": repeat, "note": "medians of interleaved rounds; the machine is "
+                 "shared with other jobs (loadavg_1min: before, after each round, after "
+                 "the cold runs)", "cases": []}
     try:
-        paths, holos = make_frames(work, args.frames, args.size)
-        n = len(paths)
-        k = [0]
-
-        def batch(scheduler: str | None, frames=paths) -> None:
-            k[0] += 1
-            s = hr.survey.run_batch(frames, work / f"s{k[0]}.zarr", z=z, scheduler=scheduler)
-            assert s["done"] == len(frames) and not s["skipped"], s
-
-        for h in holos[:3]:
-            hr.migrate(h, z)  # warm the transfer cache
-        t_migrate = best_of(lambda: [hr.migrate(h, z) for h in holos]) / n
-        t_load = best_of(lambda: [hr.load(p) for p in paths]) / n
-        t_loop = best_of(lambda: [hr.migrate(hr.load(p), z) for p in paths]) / n
-        res: dict = {"frames": n, "size": args.size, "planes": args.planes,
-                     "machine": f"{platform.machine()}, {os.cpu_count()} cores, "
-                                f"{platform.python_implementation()} "
-                                f"{platform.python_version()}",
-                     "date": time.strftime("%Y-%m-%d"),
-                     "bare_migrate_ms": 1e3 * t_migrate, "load_ms": 1e3 * t_load,
-                     "load_migrate_loop_ms": 1e3 * t_loop}
-        for name in ("synchronous", "threads", "processes"):
-            # First call (for "processes": the pool's start, kept for the session), then
-            # the fastest of the next REPEAT.
-            res[f"local_{name}_first_fps"] = n / best_of(lambda name=name: batch(name), 1)
-            res[f"local_{name}_fps"] = n / best_of(lambda name=name: batch(name))
-        # Both clusters up at once, their runs interleaved: a shared machine's background
-        # load then weighs on both alike.
-        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                          dashboard_address=":0") as c1, \
-                LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                             dashboard_address=":0") as c2:
-            addrs = {1: c1.scheduler_address, 2: c2.scheduler_address}
-            for addr in addrs.values():
-                batch(addr, paths[:8])  # warm the workers (imports, transfer cache)
-            best = {1: np.inf, 2: np.inf}
-            for _ in range(REPEAT):
-                for w, addr in addrs.items():
-                    best[w] = min(best[w], best_of(lambda addr=addr: batch(addr), 1))
-            for w in (1, 2):
-                res[f"cluster{w}_fps"] = n / best[w]
-        res["ratio_2_vs_1"] = res["cluster2_fps"] / res["cluster1_fps"]
-        per_frame = 1.0 / res["cluster1_fps"]
-        res["cluster1_ms_per_frame"] = 1e3 * per_frame
-        res["overhead_ms"] = 1e3 * (per_frame - t_migrate)
-        res["overhead_ratio"] = per_frame / t_migrate
-        res["overhead_beyond_load_ms"] = 1e3 * (per_frame - t_loop)
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster:
+            for case in cases:
+                r = run_case(case, work, repeat, cluster.scheduler_address)
+                res["cases"].append(r)
+                ms = r["ms_per_frame"]
+                print(f"{r['frames']} frames of {r['size']} x {r['size']}, "
+                      f"{r['planes']} planes of {r['pixels'][1]} x {r['pixels'][2]} "
+                      f"(load {', '.join(f'{v:.1f}' for v in r['loadavg_1min'])})")
+                for c in ("bare", "loop", "batch1", "batch2", "batch2_warm"):
+                    ratio = r["ratio_to_loop"].get(c)
+                    print(f"  {c:12s} {ms[c]:7.2f} ms/frame"
+                          + (f"   {ratio:.2f} x loop" if ratio else ""))
+                print("  cold (fresh process): " + ", ".join(
+                    f"{m} {v:.2f} s" for m, v in r["cold_s"].items()))
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    print(f"{n} frames of {args.size} x {args.size}, {args.planes} planes "
-          f"({res['machine']}, {res['date']})")
-    print(f"  bare migrate         {res['bare_migrate_ms']:8.2f} ms/frame")
-    print(f"  load                 {res['load_ms']:8.2f} ms/frame")
-    print(f"  load + migrate loop  {res['load_migrate_loop_ms']:8.2f} ms/frame")
-    for name in ("synchronous", "threads", "processes"):
-        print(f"  local {name:<14} {res[f'local_{name}_fps']:8.1f} frames/s "
-              f"(first call {res[f'local_{name}_first_fps']:.1f})")
-    print(f"  LocalCluster 1 worker  {res['cluster1_fps']:6.1f} frames/s "
-          f"({res['cluster1_ms_per_frame']:.2f} ms/frame)")
-    print(f"  LocalCluster 2 workers {res['cluster2_fps']:6.1f} frames/s: "
-          f"{res['ratio_2_vs_1']:.2f}x (aim >= 1.7x)")
-    print(f"  overhead per frame vs bare migrate: {res['overhead_ms']:.2f} ms "
-          f"({res['overhead_ratio']:.1f}x migrate); beyond load + migrate: "
-          f"{res['overhead_beyond_load_ms']:.2f} ms")
     Path(args.out).write_text(json.dumps(res, indent=1) + "\n")
     return res
 

@@ -40,6 +40,20 @@ def _expand(patterns: tuple[str, ...]) -> list[Path]:
     return out
 
 
+def _check_workers(ctx: click.Context, param: click.Parameter, value: str | None) -> int | None:
+    """--workers N: a positive integer, or a usage error saying so."""
+    if value is None:
+        return None
+    try:
+        n = int(value.strip())
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise click.BadParameter(f"must be a positive integer (the number of worker "
+                                 f"processes), got {value!r}", ctx=ctx, param=param)
+    return n
+
+
 @click.command()
 @click.argument("frames", nargs=-1, required=True)
 @click.option("-o", "--out", required=True, type=click.Path(path_type=Path),
@@ -50,20 +64,28 @@ def _expand(patterns: tuple[str, ...]) -> list[Path]:
               show_default=True)
 @click.option("--upsample", default=1, show_default=True, type=click.IntRange(1, 32),
               help="Image pixels per element pitch.")
+@click.option("--workers", default=None, metavar="N", callback=_check_workers,
+              help="Worker processes on this machine: 1 images in this process, N >= 2 "
+                   "starts a local cluster of N for the run. Default: this process, and a "
+                   "cluster of one worker per core only when the frames left after the "
+                   "first few would take over 10 s here.")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
-              help="A dask.distributed scheduler (tcp://host:8786), or threads, processes "
-                   "or synchronous; default: local processes, one per core.")
+              help="Instead of --workers: a dask.distributed scheduler (tcp://host:8786), or "
+                   "Dask's local threads, processes or synchronous.")
 @click.option("--strict", is_flag=True,
               help="Stop at the first bad frame instead of reporting and skipping it.")
 @click.option("--force", is_flag=True,
               help="Start the store afresh (settings changed) instead of refusing.")
+@click.option("--retry-bad", is_flag=True,
+              help="Read again the frames an earlier run found bad (by default a bad frame "
+                   "whose file has not changed is skipped without reading it).")
 @click.option("--layout", default=None, metavar="KEY=VALUE,...",
               help="For frames in a user's format: where the hologram is in each file (see "
                    "holoradar image --help).")
 @output_options
 def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any], method: str,
-          upsample: int, scheduler: str | None, strict: bool, force: bool,
-          layout: str | None, report: Reporter) -> None:
+          upsample: int, workers: int | None, scheduler: str | None, strict: bool,
+          force: bool, retry_bad: bool, layout: str | None, report: Reporter) -> None:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     FRAMES: hologram files or quoted patterns ('survey/*.nc'). A frame's position
@@ -73,6 +95,9 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
     from ...survey import BatchInterrupted, SettingsMismatchError, run_batch
     from ...survey.batch import bytes_text
 
+    if workers is not None and scheduler is not None:
+        raise click.UsageError("--workers starts a local cluster and --scheduler names "
+                               "another: give one of them")
     files = _expand(frames)
     zs = depth_ranges(z)
     first = _first_frame(files, layout)
@@ -95,7 +120,8 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
 
     try:
         s = run_batch(files, out, z=zs, medium=medium, method=method, upsample=upsample,
-                      scheduler=scheduler, strict=strict, overwrite=force,
+                      workers=workers, scheduler=scheduler, strict=strict, overwrite=force,
+                      retry_bad=retry_bad,
                       # A bar redraws its line with carriage returns: in a log file (stderr
                       # not a terminal) those are hundreds of lines of noise.
                       progress=report.progress and not report.as_json and sys.stderr.isatty(),
@@ -112,7 +138,9 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
         category, _, message = w.partition(": ")
         click.echo(f"warning: {' '.join(message.split())} ({category})", err=True)
     for sk in s["skipped"]:
-        click.echo(f"warning: skipped {sk['name']}: {' '.join(sk['reason'].split())}",
+        again = " (found by an earlier run, not read again; --retry-bad reads it)" \
+            if sk.get("remembered") else ""
+        click.echo(f"warning: skipped {sk['name']}: {' '.join(sk['reason'].split())}{again}",
                    err=True)
     if s["done"] == 0:  # the store holds what it held: no "wrote"
         stored = f"{_frames(s['resumed'])} already stored in {out}"
@@ -122,9 +150,16 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
         return
     report.done(s, [
         f"imaged {s['done']} frame(s), {s['resumed']} already done, {len(s['skipped'])} "
-        f"skipped, in {s['seconds']:.1f} s ({s['scheduler']})",
+        f"skipped, in {s['seconds']:.1f} s ({_where(s)})",
         f"wrote {out}",
     ], result=[f"wrote {out}"])
+
+
+def _where(s: dict[str, Any]) -> str:
+    n = s["workers"]
+    if s["scheduler"] in ("in-process", "local cluster"):
+        return f"{s['scheduler']}, {n} worker{'s' if n != 1 else ''}"
+    return str(s["scheduler"])
 
 
 def _frames(n: int) -> str:
