@@ -143,38 +143,9 @@ class _Plan:
               z0: float, dz: float, nz: int, medium: Medium, mono: bool,
               phase_incident: bool, work: np.dtype, used: np.ndarray) -> _Plan:
         Mx = grid[1]
-        # Everything depends on |p| and |q| only: compute on one quadrant of the
-        # spectrum and unfold (four times less work for a cold start).
-        p, q, kappa2, unfold = spectral_quadrant(grid, dx, dy)
-        last = medium.n_regions - 1
-        n_last = medium.n(last)
+        gain, step, jmax, unfold = frequency_terms(grid, dx, dy, ks, z0, dz, nz, medium, mono,
+                                                   phase_incident, work, used)
         nf = len(ks)
-        shape = (nf, p.size * q.size)
-        gain, step = np.empty(shape, dtype=work), np.empty(shape, dtype=work)
-        jmax = np.empty(shape, dtype=np.int32)
-        for i, k in enumerate(ks):
-            if mono:
-                a = np.conj(two_way_transfer(k, medium, kappa2, z0))
-                Kz = 2 * medium.kz(k, kappa2 / 4, last)
-                t0 = 0.5 * lateral_travel(k, medium, kappa2 / 4, z0)
-                evanescent = kappa2 > 4 * k * k
-            else:
-                a = np.conj(medium.vertical_transfer(k, kappa2, z0, 0.0))
-                Kz = medium.kz(k, kappa2, last)
-                t0 = lateral_travel(k, medium, kappa2, z0)
-                evanescent = kappa2 > k * k
-                if phase_incident:
-                    e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, z0))
-                    a = a * (np.conj(e0) / abs(e0))
-            rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
-            s = np.exp(-1j * np.conj(Kz) * dz)
-            if not mono and phase_incident:
-                s = s * np.exp(-1j * (k * n_last).real * dz)
-            gain[i], step[i] = a.ravel(), s.ravel()
-            # The band limit at the first plane (jmax < 0) is the per-plane one.
-            jmax[i] = _last_planes(a, s, evanescent, p, q, t0, rate, dz, grid, (dx, dy),
-                                   nz).ravel() if used[i] else -1
-        jmax = jmax[:, unfold]
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Live ones first, chunk of planes by chunk (a prefix for each chunk), in grid
@@ -270,6 +241,55 @@ class _Plan:
                                              u, workers)
 
 
+def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
+                    z0: float, dz: float, nz: int, medium: Medium, mono: bool,
+                    phase_incident: bool, work: np.dtype, used: np.ndarray,
+                    tiny: float = _TINY) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per frequency, on one quadrant of the spectrum: the conjugate transfer to the
+    first plane (with the incident phase for a receiver array when ``phase_incident``),
+    the plane-to-plane step ``exp(-i conj(Kz) dz)``, and the last plane each component
+    of the full grid takes part in (-1: none; a frequency with ``used[i]`` False
+    takes part nowhere). ``tiny``: a term whose weight has fallen below this fraction of
+    its frequency's largest is dropped (see :func:`_last_planes`).
+
+    Returns ``(gain, step, jmax, unfold)``: ``gain`` and ``step`` of shape (nf, quadrant
+    size) in ``work``; ``jmax`` (nf, My * Mx) int32 on the full grid; ``unfold`` the
+    quadrant index of every grid component (:func:`spectral_quadrant`). Everything
+    depends on ``|p|`` and ``|q|`` only: computed on one quadrant (four times less work
+    for a cold start).
+    """
+    p, q, kappa2, unfold = spectral_quadrant(grid, dx, dy)
+    last = medium.n_regions - 1
+    n_last = medium.n(last)
+    nf = len(ks)
+    shape = (nf, p.size * q.size)
+    gain, step = np.empty(shape, dtype=work), np.empty(shape, dtype=work)
+    jmax = np.empty(shape, dtype=np.int32)
+    for i, k in enumerate(ks):
+        if mono:
+            a = np.conj(two_way_transfer(k, medium, kappa2, z0))
+            Kz = 2 * medium.kz(k, kappa2 / 4, last)
+            t0 = 0.5 * lateral_travel(k, medium, kappa2 / 4, z0)
+            evanescent = kappa2 > 4 * k * k
+        else:
+            a = np.conj(medium.vertical_transfer(k, kappa2, z0, 0.0))
+            Kz = medium.kz(k, kappa2, last)
+            t0 = lateral_travel(k, medium, kappa2, z0)
+            evanescent = kappa2 > k * k
+            if phase_incident:
+                e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, z0))
+                a = a * (np.conj(e0) / abs(e0))
+        rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
+        s = np.exp(-1j * np.conj(Kz) * dz)
+        if not mono and phase_incident:
+            s = s * np.exp(-1j * (k * n_last).real * dz)
+        gain[i], step[i] = a.ravel(), s.ravel()
+        # The band limit at the first plane (jmax < 0) is the per-plane one.
+        jmax[i] = _last_planes(a, s, evanescent, p, q, t0, rate, dz, grid, (dx, dy),
+                               nz, tiny).ravel() if used[i] else -1
+    return gain, step, jmax[:, unfold], unfold
+
+
 def _small_int(top: int) -> type:
     """The smallest signed integer type holding ``-top..top`` (numpy sorts 16-bit
     integers by radix, stably and fast)."""
@@ -278,13 +298,14 @@ def _small_int(top: int) -> type:
 
 def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.ndarray,
                  q: np.ndarray, t0: np.ndarray, rate: np.ndarray, dz: float,
-                 grid: tuple[int, int], pitch: tuple[float, float], nz: int) -> np.ndarray:
+                 grid: tuple[int, int], pitch: tuple[float, float], nz: int,
+                 tiny: float = _TINY) -> np.ndarray:
     """The last plane index each component takes part in (-1: none, at most nz - 1).
 
     Band limit: the lateral shift ``|p| t(z)``, ``t(z) = t0 + (z - z0) rate``, must
     stay within half the grid (as in the per-plane transfer). Decay: a component
-    whose weight ``|a| |step|^j`` has fallen below ``_TINY`` of the frequency's
-    largest is zero to rounding (evanescent waves, absorption).
+    whose weight ``|a| |step|^j`` has fallen below ``tiny`` (default ``_TINY``) of the
+    frequency's largest is zero to rounding (evanescent waves, absorption).
     """
     My, Mx = grid
     dx, dy = pitch
@@ -294,7 +315,7 @@ def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.
         j_band = np.floor((room - t0) / (rate * dz))
         j_band = np.where(evanescent, np.inf, np.nan_to_num(j_band, nan=np.inf, neginf=-1))
         mag = np.abs(a)
-        floor = _TINY * mag.max(initial=0.0)
+        floor = tiny * mag.max(initial=0.0)
         decay = np.abs(step)
         j_decay = np.where(decay < 1, np.floor(np.log(floor / mag) / np.log(decay)), np.inf)
         j_decay = np.where(mag > floor, np.nan_to_num(j_decay, nan=np.inf), -1)

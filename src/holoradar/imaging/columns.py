@@ -1,0 +1,358 @@
+"""The wideband phase-shift sum, compiled: one pass over each spectral column.
+
+For every component ``(kx, ky)`` of the (padded) FFT grid that some frequency still
+needs, the coherent image's spectrum on uniform planes ``z_j = z_0 + j dz`` is
+
+    I(kx, ky, z_j) = sum_f A_f(kx, ky) s_f(kx, ky)^j,   j <= jmax_f(kx, ky),
+
+``A_f`` the weighted spectrum taken to the first plane and ``s_f = exp(-i conj(Kz_f) dz)``
+the plane-to-plane step (the same terms as :mod:`holoradar.imaging.kspace`, built by
+:func:`~holoradar.imaging.kspace.frequency_terms`: in a half-space the ground's
+``Kz`` after the air gap's transfer; for a receiver array the normal plane wave's
+incident phase). A compiled loop (numba) carries each column's ``nf`` terms from plane
+to plane: ``nf`` complex multiply-adds per component and plane, run over blocks of
+components in cache, real and imaginary parts apart so that the compiler vectorises
+them. Each block of planes is then one pruned inverse FFT (along x over the rows that
+hold components, cropped to the aperture, then along y).
+
+The result is the phase-shift sum of :func:`holoradar.imaging.kspace.migrate_kspace`
+to rounding: the recurrence's error grows by one rounding per step, ``~j eps``
+(``eps`` = 6e-8 in complex64, 1.1e-16 in complex128).
+
+numba is imported on the first call (not with holoradar); its compiled loop is cached
+on disk (``cache=True``) next to this module, or under ``NUMBA_CACHE_DIR``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+import numpy as np
+
+from .._lazy import lazy_module
+from .._threads import POOL_SIZE, pool
+from ..data.hologram import Hologram, Image
+from ..physics.medium import Medium
+from ..physics.propagation import _CACHE, padded_shape
+from . import kspace
+
+sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
+
+__all__ = ["available", "migrate_columns", "output_bytes"]
+
+_COLS = 256          # components per block of the compiled loop (its terms stay in cache)
+_THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
+_BUFFER_SHARE = 0.5  # inverse-FFT buffers at most this share of the output volume
+# A term whose weight fell below this fraction of its frequency's largest is dropped:
+# below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128.
+_TINY = {"F": 1e-9, "D": kspace._TINY}
+
+
+def available() -> bool:
+    """Whether numba can be imported (the compiled sum's only requirement)."""
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@cache
+def _kernel() -> Any:
+    """The compiled column sum (numba, cached on disk; built on first use)."""
+    import numba
+
+    @numba.njit(cache=True, fastmath=False, nogil=True, error_model="numpy")
+    def column_sum(ar, ai, sr, si, jm, bend, pos, order, n, j0, j1, zero, outv):
+        # Block-major (nblocks, nf, L): ar, ai each term's value at plane j0 (updated in
+        # place to j1); sr, si its step; jm its last plane; bend (nblocks,) the last
+        # plane of any term of a block; pos (nblocks, L) where component b * L + c goes
+        # in a plane of outv (real part at 2 pos, imaginary at 2 pos + 1), which holds
+        # zeros on entry; order: the blocks to do (a thread's share);
+        # n components. Four planes per pass over a block's terms (the terms are read
+        # and written once for four multiply-adds), then one plane at a time.
+        nf, L = ar.shape[1:]
+        for t in range(order.size):
+            b = order[t]
+            if bend[b] < j0:
+                continue
+            m = min(L, n - b * L)
+            p = pos[b]
+            a_r, a_i, s_r, s_i, j_m = ar[b], ai[b], sr[b], si[b], jm[b]
+            acc = np.empty((8, L), ar.dtype)
+            stop = min(j1, bend[b] + 1)
+            j = j0
+            while j < stop:
+                k = 4 if j + 4 <= stop else 1
+                for c in range(L):
+                    for q in range(2 * k):
+                        acc[q, c] = zero
+                a0r, a0i, a1r, a1i = acc[0], acc[1], acc[2], acc[3]
+                a2r, a2i, a3r, a3i = acc[4], acc[5], acc[6], acc[7]
+                for f in range(nf):
+                    xr_, xi_, sr_, si_, jm_ = a_r[f], a_i[f], s_r[f], s_i[f], j_m[f]
+                    if k == 4:
+                        for c in range(L):
+                            xr = xr_[c]
+                            xi = xi_[c]
+                            cr = sr_[c]
+                            ci = si_[c]
+                            last = jm_[c]
+                            a0r[c] += xr
+                            a0i[c] += xi
+                            yr = xr * cr - xi * ci
+                            yi = xr * ci + xi * cr
+                            xr = yr if last > j else zero
+                            xi = yi if last > j else zero
+                            a1r[c] += xr
+                            a1i[c] += xi
+                            yr = xr * cr - xi * ci
+                            yi = xr * ci + xi * cr
+                            xr = yr if last > j + 1 else zero
+                            xi = yi if last > j + 1 else zero
+                            a2r[c] += xr
+                            a2i[c] += xi
+                            yr = xr * cr - xi * ci
+                            yi = xr * ci + xi * cr
+                            xr = yr if last > j + 2 else zero
+                            xi = yi if last > j + 2 else zero
+                            a3r[c] += xr
+                            a3i[c] += xi
+                            yr = xr * cr - xi * ci
+                            yi = xr * ci + xi * cr
+                            xr_[c] = yr if last > j + 3 else zero
+                            xi_[c] = yi if last > j + 3 else zero
+                    else:
+                        for c in range(L):
+                            xr = xr_[c]
+                            xi = xi_[c]
+                            a0r[c] += xr
+                            a0i[c] += xi
+                            yr = xr * sr_[c] - xi * si_[c]
+                            yi = xr * si_[c] + xi * sr_[c]
+                            xr_[c] = yr if jm_[c] > j else zero
+                            xi_[c] = yi if jm_[c] > j else zero
+                for q in range(k):
+                    o = outv[j + q - j0]
+                    for c in range(m):
+                        o[2 * p[c]] = acc[2 * q, c]
+                        o[2 * p[c] + 1] = acc[2 * q + 1, c]
+                j += k
+
+    return column_sum
+
+
+def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int, j1: int,
+         zero: Any, outv: np.ndarray) -> None:
+    """Planes ``j0 .. j1 - 1`` of the compiled sum into ``outv``, the blocks shared
+    among the process's threads when the work is worth it (the loop releases the GIL).
+
+    The blocks go round-robin (the deepest-reaching come first, so each thread gets its
+    share of long and short ones); they write disjoint components.
+    """
+    live = np.flatnonzero(plan.bend >= j0)
+    work = int(np.minimum(plan.bend[live] + 1, j1).sum() - j0 * live.size) * plan.nf * _COLS
+    nt = min(POOL_SIZE, live.size)
+    if nt < 2 or work < _THREADED_TERMS:
+        kernel(ar, ai, plan.sr, plan.si, plan.jm, plan.bend, plan.pos, live, plan.live.size,
+               j0, j1, zero, outv)
+        return
+    list(pool().map(lambda i: kernel(ar, ai, plan.sr, plan.si, plan.jm, plan.bend, plan.pos,
+                                     live[i::nt], plan.live.size, j0, j1, zero, outv),
+                    range(nt)))
+
+
+def output_bytes(hologram: Hologram, nz: int, upsample: int, dtype: Any) -> int:
+    """Bytes of the image volume ``migrate`` returns (all leading axes, ``nz`` planes)."""
+    ny, nx = hologram.data.shape[-2:]
+    u = int(upsample)
+    lead = hologram.data.shape[:-3] if hologram.is_wideband else hologram.data.shape[:-2]
+    return int(np.prod(lead, dtype=np.int64)) * nz * (u * (ny - 1) + 1) * (u * (nx - 1) + 1) \
+        * np.dtype(dtype).itemsize
+
+
+def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: np.ndarray,
+                    *, pad: Any = True, upsample: int = 1, dtype: Any = None) -> Image:
+    """The coherent wideband image on uniform planes ``zs`` by the compiled column sum.
+
+    Parameters
+    ----------
+    hologram : Hologram
+        Wideband (..., nf, ny, nx), a transceiver's or a receiver array's lit by a
+        normal plane wave (or none: phase 0 at the aperture assumed).
+    zs : numpy.ndarray
+        Uniformly spaced ranges, metres, all in the medium's deepest region.
+    medium : Medium
+        The layers (free space included); lossless, or loss left uncompensated.
+    weights : numpy.ndarray
+        One weight per frequency.
+    pad, upsample, dtype
+        As in :func:`holoradar.migrate`.
+
+    Returns
+    -------
+    Image
+        (..., nz, ny', nx'), ``method="kspace:coherent"``: the same sum as
+        :func:`holoradar.imaging.kspace.migrate_kspace`, to rounding.
+    """
+    mono = hologram.monostatic
+    dx, dy = hologram.pitch
+    ny, nx = hologram.data.shape[-2:]
+    work = np.dtype(dtype if dtype is not None else (
+        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
+    real = np.float32 if work == np.complex64 else np.float64
+    lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
+    grid = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam, z_max=float(zs.max()))
+    workers = -1 if grid[0] * grid[1] >= 128 * 128 else 1
+    weights = np.asarray(weights, dtype=float)
+    u = int(upsample)
+    direct = u == 1 and grid == (ny, nx)
+    key = ("columns", grid, dx, dy, tuple(float(k) for k in hologram.wavenumbers),
+           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, direct, work.str,
+           tuple(weights != 0))
+    plan = _CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
+    data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
+    batch = data.shape[:-3]
+    data = data.reshape((-1, *data.shape[-3:]))
+    oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
+    out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
+    run = _kernel()
+    My, Mx = grid
+    zero = real(0)
+    if plan.direct:
+        # Unpadded, no interpolation: the compiled loop writes the spectra into the
+        # output itself, transformed there in place.
+        chunk = 16
+        for b in range(data.shape[0]):
+            ar, ai = plan.gather(data[b], weights, work, workers)
+            for j0 in range(0, zs.size, chunk):
+                j1 = min(zs.size, j0 + chunk)
+                o = out[b, j0:j1]
+                o.fill(0)
+                _run(run, plan, ar, ai, j0, j1, zero, o.view(real).reshape(j1 - j0, -1))
+                done = sfft.ifft2(o, axes=(-2, -1), workers=workers, overwrite_x=True)
+                if not np.shares_memory(done, o):
+                    o[...] = done
+    else:
+        nr = plan.rows.size
+        per_plane = (nr * u * Mx + 2 * u * My * ox) * work.itemsize
+        chunk = int(max(1, min(32, _BUFFER_SHARE * out[0].nbytes // max(per_plane, 1))))
+        buf = np.empty((chunk, nr, Mx), dtype=work)
+        for b in range(data.shape[0]):
+            ar, ai = plan.gather(data[b], weights, work, workers)
+            for j0 in range(0, zs.size, chunk):
+                j1 = min(zs.size, j0 + chunk)
+                m = j1 - j0
+                buf.fill(0)
+                _run(run, plan, ar, ai, j0, j1, zero, buf.view(real).reshape(chunk, -1))
+                xb = buf[:m] if u == 1 else kspace._pad_axis(buf[:m], u, -1)
+                half = sfft.ifft(xb, axis=-1, workers=workers, overwrite_x=True)
+                cols = np.zeros((m, My, ox), dtype=work)
+                cols[:, plan.rows] = half[..., :ox]
+                yb = cols if u == 1 else kspace._pad_axis(cols, u, -2)
+                planes = sfft.ifft(yb, axis=-2, workers=workers, overwrite_x=True)
+                if u > 1:
+                    np.multiply(planes[:, :oy], u * u, out=out[b, j0:j1])
+                else:
+                    out[b, j0:j1] = planes[:, :oy]
+    out = out.reshape((*batch, zs.size, oy, ox))
+    x = hologram.x[0] + np.arange(ox) * dx / u
+    y = hologram.y[0] + np.arange(oy) * dy / u
+    return Image(out, x, y, zs, hologram.frequencies.copy(), "kspace:coherent")
+
+
+@dataclass
+class ColumnPlan:
+    """What a geometry needs for the compiled sum, built once (cached with the
+    transfer functions): the live components in row order, and per frequency their
+    gain to the first plane, their step (real and imaginary parts apart) and the last
+    plane each takes part in."""
+
+    grid: tuple[int, int]
+    live: np.ndarray   # (n,) flat indices into the padded grid, deepest-reaching first
+    gain: np.ndarray   # (nf, n) conj transfer to the first plane (work dtype)
+    sr: np.ndarray     # (nf, n) step, real part
+    si: np.ndarray     # (nf, n) step, imaginary part
+    jm: np.ndarray     # (nf, n) int32 last plane (-1: never)
+    bend: np.ndarray   # (nblocks,) int32 last plane of any term of a block of _COLS
+    rows: np.ndarray   # (nr,) grid rows holding live components
+    pos: np.ndarray    # (nblocks, _COLS) where each component goes in a plane: its flat
+    #                    grid index (direct) or its index in a (nr, Mx) plane of rows
+    direct: bool       # the grid is the output's: spectra written into the output itself
+
+    @property
+    def nf(self) -> int:
+        return self.gain.shape[0]
+
+    @property
+    def nbytes(self) -> int:
+        return sum(a.nbytes for a in (self.live, self.gain, self.sr, self.si, self.jm,
+                                      self.bend, self.rows, self.pos))
+
+    @classmethod
+    def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
+              z0: float, dz: float, nz: int, medium: Medium, mono: bool, direct: bool,
+              work: np.dtype, used: np.ndarray) -> ColumnPlan:
+        Mx = grid[1]
+        gain_q, step_q, jmax, unfold = kspace.frequency_terms(
+            grid, dx, dy, ks, z0, dz, nz, medium, mono, True, work, used, _TINY[work.char])
+        reach = jmax.max(axis=0)
+        live = np.flatnonzero(reach >= 0)
+        # Deepest-reaching first (stable: grid order among equals), so that the blocks
+        # still needed at a plane are a prefix and a block's terms end together.
+        live = live[np.argsort(-reach[live], kind="stable")]
+        n = live.size
+        nb = max(1, -(-n // _COLS))
+        q_idx = unfold[live]
+        gain = gain_q[:, q_idx]
+        jm = jmax[:, live]
+        gain[jm < 0] = 0
+        real = np.float32 if work == np.complex64 else np.float64
+
+        def blocked(values: np.ndarray, fill: Any, dtype: Any) -> np.ndarray:
+            out = np.full((values.shape[0], nb * _COLS), fill, dtype=dtype)
+            out[:, :n] = values
+            return np.ascontiguousarray(out.reshape(-1, nb, _COLS).transpose(1, 0, 2))
+
+        step = step_q[:, q_idx]
+        bend = np.full(nb, -1, dtype=np.int32)
+        if n:
+            bend[:] = np.maximum.reduceat(reach[live], np.arange(0, n, _COLS))
+        rows = live // Mx
+        used_rows = np.unique(rows)
+        pos = np.zeros(nb * _COLS, dtype=np.int64)
+        pos[:n] = live if direct else np.searchsorted(used_rows, rows) * Mx + live % Mx
+        plan = cls(grid, live, gain, blocked(step.real, 0, real), blocked(step.imag, 0, real),
+                   blocked(jm, -1, np.int32), bend, used_rows, pos.reshape(nb, _COLS), direct)
+        for arr in (plan.live, plan.gain, plan.sr, plan.si, plan.jm, plan.bend, plan.rows,
+                    plan.pos):
+            arr.setflags(write=False)
+        return plan
+
+    def gather(self, data: np.ndarray, weights: np.ndarray, work: np.dtype, workers: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """The live components of ``data`` (nf, ny, nx), weighted and taken to the first
+        plane: real and imaginary parts, each (nblocks, nf, _COLS), ready for the
+        compiled loop.
+
+        One frequency at a time: a pruned forward FFT on the padded grid (along x over
+        the recorded rows, then along y).
+        """
+        My, Mx = self.grid
+        n = self.live.size
+        real = np.float32 if work == np.complex64 else np.float64
+        nb = self.sr.shape[0]
+        ar = np.empty(self.sr.shape, dtype=real)
+        ai = np.empty_like(ar)
+        v = np.zeros(nb * _COLS, dtype=work)
+        for i in range(self.nf):
+            H = sfft.fft(data[i].astype(work, copy=False), n=Mx, axis=-1, workers=workers)
+            H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
+            np.take(H.reshape(-1), self.live, out=v[:n])
+            v[:n] *= self.gain[i]
+            v[:n] *= work.type(weights[i])
+            ar[:, i] = v.real.reshape(nb, _COLS)
+            ai[:, i] = v.imag.reshape(nb, _COLS)
+        return ar, ai
