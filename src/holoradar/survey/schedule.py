@@ -267,7 +267,7 @@ def _run_on_cluster(func: Any, tasks: list[list[Any]], job: Any, client: Any, *,
 
 def local_cluster(workers: int) -> tuple[Any, Any]:
     """A ``dask.distributed.LocalCluster`` of ``workers`` processes of one thread each, and
-    its client, for one run (the caller closes both).
+    its client, for one run (the caller closes both). Its dashboard takes a free port.
 
     Each worker imports what a task needs as it starts
     (:mod:`holoradar.survey.warm`: the imaging code, SciPy's FFT, h5py, Zarr),
@@ -279,7 +279,7 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
     from distributed import Client, LocalCluster
 
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR,
+                           dashboard_address=":0", silence_logs=logging.ERROR,
                            preload=["holoradar.survey.warm"])
     try:
         client = Client(cluster, set_as_default=False)
