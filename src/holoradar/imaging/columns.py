@@ -44,7 +44,8 @@ __all__ = ["available", "migrate_columns", "output_bytes"]
 
 _COLS = 256          # components per block of the compiled loop (its terms stay in cache)
 _THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
-_BUFFER_SHARE = 0.5  # inverse-FFT buffers at most this share of the output volume
+_BUFFER_SHARE = 0.5  # inverse-FFT buffers at most this share of the output volume,
+_BUFFER_MIN = 1 << 24  # or 16 MiB
 # A term whose weight fell below this fraction of its frequency's largest is dropped:
 # below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128.
 _TINY = {"F": 1e-9, "D": kspace._TINY}
@@ -160,7 +161,8 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
                j0, j1, zero, outv)
         return
     list(pool().map(lambda i: kernel(ar, ai, plan.sr, plan.si, plan.jm, plan.bend, plan.pos,
-                                     live[i::nt], plan.live.size, j0, j1, zero, outv),
+                                     np.ascontiguousarray(live[i::nt]), plan.live.size,
+                                     j0, j1, zero, outv),
                     range(nt)))
 
 
@@ -238,7 +240,8 @@ def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights:
     else:
         nr = plan.rows.size
         per_plane = (nr * u * Mx + 2 * u * My * ox) * work.itemsize
-        chunk = int(max(1, min(32, _BUFFER_SHARE * out[0].nbytes // max(per_plane, 1))))
+        budget = max(_BUFFER_SHARE * out[0].nbytes, _BUFFER_MIN)
+        chunk = int(max(1, min(32, budget // per_plane)))
         buf = np.empty((chunk, nr, Mx), dtype=work)
         for b in range(data.shape[0]):
             ar, ai = plan.gather(data[b], weights, work, workers)
