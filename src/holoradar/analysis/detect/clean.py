@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 
 from .grid import Volume, refine_peak
-from .noise import NoiseModel, candidate_noise, local_noise, threshold_resels
+from .noise import NoiseModel, local_noise, threshold_resels
+from .reference import candidate_noise
 
 __all__ = ["CleanResult", "Component", "clean"]
 

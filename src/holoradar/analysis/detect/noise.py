@@ -45,7 +45,7 @@ from ..._lazy import lazy_module
 _opt = lazy_module("scipy.optimize")  # imported on first use: see holoradar._lazy
 _special = lazy_module("scipy.special")
 
-__all__ = ["NoiseModel", "box_resels", "candidate_noise", "expected_false_peaks",
+__all__ = ["NoiseModel", "box_resels", "expected_false_peaks",
            "local_noise", "spectral_cells", "threshold", "threshold_resels"]
 
 _A = np.sqrt(np.pi / 6)  # sqrt(lambda/(2 pi)) times the cell pi/sqrt(3 lambda)
@@ -401,49 +401,3 @@ def local_noise(residual: np.ndarray, mask: np.ndarray, x: np.ndarray, y: np.nda
     n_ref = max(4 * np.pi * SMOOTH_CELLS**2, 1.0)
     t = threshold_resels(false_alarm * max(n_cells, 1.0), resels, n_ref)
     return NoiseModel(sigma2, (cx, cy, cell[2]), float(n_cells), resels, n_ref, t)
-
-
-GUARD_CELLS = 1.0
-"""Half-width of the guard region left out of a candidate's own noise estimate, cells."""
-
-
-def candidate_noise(residual: np.ndarray, mask: np.ndarray, index: tuple[int, int, int],
-                    x: np.ndarray, y: np.ndarray, cell: tuple[float, float, float]
-                    ) -> tuple[float, float]:
-    """Noise variance at a candidate, and the independent cells behind it.
-
-    The Gaussian window of :func:`local_noise` around the candidate's pixel, less a
-    guard box of :data:`GUARD_CELLS` cells each way and the objects' main lobes:
-    the candidate's own peak must not raise its reference (cell-averaging CFAR's
-    guard cells; with it included the rate of false objects fell to a quarter of
-    the nominal one on 16 x 16 noise images). The effective number of cells of the
-    weights ``w`` is ``(sum w)^2 / sum w^2`` over the pixels per cell.
-
-    Returns
-    -------
-    sigma2 : float
-    n_ref : float
-
-    Examples
-    --------
-    >>> r = np.ones((1, 40, 40), complex)
-    >>> s2, n = candidate_noise(r, np.zeros((40, 40), bool), (0, 20, 20), np.arange(40.0),
-    ...                         np.arange(40.0), (4.0, 4.0, np.inf))
-    >>> s2, bool(40 < n < 120)
-    (1.0, True)
-    """
-    iz, iy, ix = index
-    dx, dy = float(x[1] - x[0]), float(y[1] - y[0])
-    u = (x - x[ix]) / (SMOOTH_CELLS * cell[0])
-    v = (y - y[iy]) / (SMOOTH_CELLS * cell[1])
-    w = np.exp(-0.5 * v[:, None] ** 2) * np.exp(-0.5 * u[None, :] ** 2)
-    guard = ((np.abs(y - y[iy]) <= GUARD_CELLS * cell[1])[:, None]
-             & (np.abs(x - x[ix]) <= GUARD_CELLS * cell[0])[None, :])
-    w = np.where(guard | mask, 0.0, w)
-    if w.sum() <= 0:
-        w = np.where(guard, 0.0, 1.0)
-    p = np.abs(residual[iz]) ** 2
-    s2 = float(np.sum(w * p) / np.sum(w))
-    per_cell = cell[0] * cell[1] / (dx * dy)
-    n = float(np.sum(w) ** 2 / np.sum(w * w) / max(per_cell, 1.0))
-    return s2, max(n, 1.0)
