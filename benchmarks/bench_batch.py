@@ -112,10 +112,12 @@ def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
 
     def batch(**kw) -> None:
         k[0] += 1
-        store = work / f"s{k[0]}.zarr"
-        s = hr.survey.run_batch(paths, store, z=z, upsample=up, **kw)
+        s = hr.survey.run_batch(paths, work / f"s{k[0]}.zarr", z=z, upsample=up, **kw)
         assert s["done"] == n and not s["skipped"], s
-        shutil.rmtree(store, ignore_errors=True)
+
+    def clean() -> None:  # the stores of a round, removed outside the clock
+        for old in work.glob("s*.zarr"):
+            shutil.rmtree(old, ignore_errors=True)
 
     for h in holos[:3]:
         hr.migrate(h, z, upsample=up)  # warm this process (imports, FFT plans)
@@ -127,6 +129,7 @@ def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
                               hr.migrate(hr.load(paths[i]), z, upsample=up).data)
     shutil.rmtree(store)
     batch(scheduler=cluster_address)  # the warm cluster's workers: imports done
+    clean()
     cases = {
         "bare": lambda: [hr.migrate(h, z, upsample=up) for h in holos],
         "loop": lambda: [hr.migrate(hr.load(p), z, upsample=up) for p in paths],
@@ -142,6 +145,7 @@ def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
             w, c = timed(fn)
             wall[name].append(w)
             cpu[name].append(c)
+        clean()
         load.append(os.getloadavg()[0])
     med = {c: float(np.median(v)) / n for c, v in wall.items()}
     res = {**case, "pixels": [planes, up * (size - 1) + 1, up * (size - 1) + 1],
@@ -177,7 +181,7 @@ def main() -> dict:
                  "the cold runs)", "cases": []}
     try:
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster:
+                          dashboard_address=":0") as cluster:
             for case in cases:
                 r = run_case(case, work, repeat, cluster.scheduler_address)
                 res["cases"].append(r)

@@ -4,7 +4,7 @@ Layout (``survey.zarr``; dimensions named, so ``xarray.open_zarr`` reads it)::
 
     image       (frame, z, y, x, iq)  float64 (float32 for complex64 frames); I = iq 0,
                                       Q = iq 1; chunks of several frames (up to
-                                      4 MiB, :func:`frames_per_chunk`), compressed
+                                      16 MiB, :func:`frames_per_chunk`), compressed
                                       (Blosc LZ4, byte shuffle); NaN until written
     z           (z,)     ranges of the planes from the aperture, m
     y, x        (y,) (x,)  pixel offsets from the frame's centre, m (the same for all)
@@ -74,11 +74,11 @@ _PER_FRAME = ("position", "finished", "done")  # one chunk per frame
 _NAMES = ("frame_name", "frame_path")                               # written by the driver
 FRAME_ARRAYS = ("image", *_PER_FRAME, *_NAMES)
 _NAME_CHUNK = 1024
-CHUNK_BYTES = 4 * 2**20
+CHUNK_BYTES = 16 * 2**20
 """Most bytes (before compression) of the images in one chunk: several frames share a
-chunk when theirs are small, so that a small frame is not one tiny file and four tiny
-writes (the per-write cost of Zarr, ~1 ms, was the largest part of the old per-frame
-overhead), while a task (one chunk) stays short enough to balance the workers."""
+chunk when theirs are small, so that a frame is not four writes of its own (each write
+through Zarr costs a millisecond or more besides its bytes), while a task (one chunk)
+stays short enough to balance the workers and two chunks in memory stay small."""
 _MOST_FRAMES_PER_CHUNK = 64
 
 
@@ -90,7 +90,7 @@ def frames_per_chunk(per_frame: int, n_frames: int) -> int:
     Examples
     --------
     >>> frames_per_chunk(571536, 120), frames_per_chunk(32768, 200), frames_per_chunk(2**24, 9)
-    (7, 13, 1)
+    (8, 13, 1)
     """
     return max(1, min(_MOST_FRAMES_PER_CHUNK, CHUNK_BYTES // max(1, per_frame),
                       -(-n_frames // 16)))
