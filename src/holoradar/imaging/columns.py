@@ -250,10 +250,12 @@ def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights:
                 m = j1 - j0
                 buf.fill(0)
                 _run(run, plan, ar, ai, j0, j1, zero, buf.view(real).reshape(chunk, -1))
-                xb = buf[:m] if u == 1 else kspace._pad_axis(buf[:m], u, -1)
+                nr_j = int(np.count_nonzero(plan.row_reach >= j0))
+                xb = buf[:m, :nr_j]
+                xb = xb if u == 1 else kspace._pad_axis(xb, u, -1)
                 half = sfft.ifft(xb, axis=-1, workers=workers, overwrite_x=True)
                 cols = np.zeros((m, My, ox), dtype=work)
-                cols[:, plan.rows] = half[..., :ox]
+                cols[:, plan.rows[:nr_j]] = half[..., :ox]
                 yb = cols if u == 1 else kspace._pad_axis(cols, u, -2)
                 planes = sfft.ifft(yb, axis=-2, workers=workers, overwrite_x=True)
                 if u > 1:
@@ -280,7 +282,8 @@ class ColumnPlan:
     si: np.ndarray     # (nf, n) step, imaginary part
     jm: np.ndarray     # (nf, n) int32 last plane (-1: never)
     bend: np.ndarray   # (nblocks,) int32 last plane of any term of a block of _COLS
-    rows: np.ndarray   # (nr,) grid rows holding live components
+    rows: np.ndarray   # (nr,) grid rows holding live components, deepest-reaching first
+    row_reach: np.ndarray  # (nr,) the last plane any component of each row reaches
     pos: np.ndarray    # (nblocks, _COLS) where each component goes in a plane: its flat
     #                    grid index (direct) or its index in a (nr, Mx) plane of rows
     direct: bool       # the grid is the output's: spectra written into the output itself
@@ -292,7 +295,7 @@ class ColumnPlan:
     @property
     def nbytes(self) -> int:
         return sum(a.nbytes for a in (self.live, self.gain, self.sr, self.si, self.jm,
-                                      self.bend, self.rows, self.pos))
+                                      self.bend, self.rows, self.row_reach, self.pos))
 
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
@@ -323,14 +326,21 @@ class ColumnPlan:
         bend = np.full(nb, -1, dtype=np.int32)
         if n:
             bend[:] = np.maximum.reduceat(reach[live], np.arange(0, n, _COLS))
+        # The row buffer of the inverse FFT holds the rows deepest-reaching first, so
+        # that the rows still needed at a plane are a prefix (transformed alone).
         rows = live // Mx
-        used_rows = np.unique(rows)
+        row_reach = np.full(grid[0], -1, dtype=np.int64)
+        np.maximum.at(row_reach, rows, reach[live])
+        used_rows = np.argsort(-row_reach, kind="stable")[:np.count_nonzero(row_reach >= 0)]
+        rank = np.empty(grid[0], dtype=np.int64)
+        rank[used_rows] = np.arange(used_rows.size)
         pos = np.zeros(nb * _COLS, dtype=np.int64)
-        pos[:n] = live if direct else np.searchsorted(used_rows, rows) * Mx + live % Mx
+        pos[:n] = live if direct else rank[rows] * Mx + live % Mx
         plan = cls(grid, live, gain, blocked(step.real, 0, real), blocked(step.imag, 0, real),
-                   blocked(jm, -1, np.int32), bend, used_rows, pos.reshape(nb, _COLS), direct)
+                   blocked(jm, -1, np.int32), bend, used_rows, row_reach[used_rows],
+                   pos.reshape(nb, _COLS), direct)
         for arr in (plan.live, plan.gain, plan.sr, plan.si, plan.jm, plan.bend, plan.rows,
-                    plan.pos):
+                    plan.row_reach, plan.pos):
             arr.setflags(write=False)
         return plan
 
