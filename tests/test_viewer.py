@@ -397,3 +397,144 @@ def test_page_layout_stretches_and_fits_a_1000_px_window(scene, tmp_path):
     assert all(w.width <= controls.width for w in controls.children if w.width)
     # every figure below the plan stretches too
     assert all(f.sizing_mode == "stretch_width" for f in page.hfigs)
+
+
+# ----------------------------------------------------------------------------- objects
+def _objects_table():
+    """Three objects as holoradar.detect tabulates them (its columns): a point, a line
+    along x through the origin, and an area with its outline (metres)."""
+    import pandas as pd
+
+    from holoradar.analysis.detect.table import COLUMNS
+
+    nan = float("nan")
+    rows = [
+        {"kind": "point", "x": 0.02, "y": -0.01, "range": 0.42, "depth": 0.12,
+         "depth_low": 0.11, "depth_high": 0.135, "length": 0.0, "width": 0.0,
+         "snr_db": 21.3},
+        {"kind": "line", "x": 0.0, "y": 0.0, "range": 0.40, "depth": 0.10, "length": 0.10,
+         "width": 0.01, "azimuth_deg": 0.0, "x_start": -0.05, "y_start": 0.0,
+         "x_end": 0.05, "y_end": 0.0, "snr_db": 15.0},
+        {"kind": "area", "x": -0.05, "y": 0.05, "range": 0.45, "depth": 0.15,
+         "length": 0.06, "width": 0.04, "azimuth_deg": 0.0, "snr_db": 12.04, "area": 0.0024},
+    ]
+    df = pd.DataFrame([{c: r.get(c, nan) for c in COLUMNS} for r in rows], columns=COLUMNS)
+    df.attrs["outlines"] = {2: [[-0.08, 0.03], [-0.02, 0.03], [-0.02, 0.07], [-0.08, 0.07]]}
+    return df
+
+
+def test_page_overlays_and_lists_the_objects(scene, tmp_path):
+    # The glyph sources carry the table's rows (cm), numbered from 1 in its order; the
+    # list shows them; choosing a row moves the slider to its depth and the sections
+    # through it.
+    from bokeh.document import Document
+
+    from holoradar.app.view.page import ViewerPage
+
+    paths, _, _ = scene
+    S = ViewSession(paths[:1])
+    df = _objects_table()
+    page = ViewerPage(Document(), S, S.default_settings(ground=SAND).replace(depth=0.1, planes=5),
+                      tmp_path, objects=df)
+    src = {k: dict(v.data) for k, v in page.obj_src.items()}
+    assert src["points"] == {"x": [2.0], "y": [-1.0], "n": [1]}
+    assert src["lines"] == {"x0": [-5.0], "y0": [0.0], "x1": [5.0], "y1": [0.0], "n": [2]}
+    np.testing.assert_allclose(src["areas"]["xs"][0], [-8.0, -2.0, -2.0, -8.0], atol=1e-12)
+    np.testing.assert_allclose(src["areas"]["ys"][0], [3.0, 3.0, 7.0, 7.0], atol=1e-12)
+    assert src["areas"]["n"] == [3] and src["labels"]["text"] == ["1", "2", "3"]
+    table = dict(page.obj_table_src.data)
+    assert table["n"] == [1, 2, 3] and table["kind"] == ["point", "line", "area"]
+    assert table["depth"] == ["12.0 [11.0, 13.5]", "10.0", "15.0"]
+    assert table["size"] == ["-", "10.0 long", "6.0 x 4.0"]
+    assert table["snr"] == ["21.3", "15.0", "12.0"]
+    # the page's depth axis: range less the surface (0.30 m)
+    np.testing.assert_allclose(table["at"], [12.0, 10.0, 15.0], atol=1e-9)
+    page.obj_table_src.selected.indices = [2]
+    assert page.depth.value == pytest.approx(15.0)
+    assert page.s.section == (-0.05, 0.05)
+    # On the sections: the objects within half a resolution cell of their planes (from a
+    # file without one: two pixels, 2 x 2.5 cm / 4, or 1 cm). Through (0, 0): the point
+    # 1 cm off y = 0 and the line along x on the x-z section; on the y-z section the
+    # line where it crosses x = 0, its middle.
+    assert page._near() == pytest.approx(0.0125)
+    page.section_at = (0.0, 0.0)
+    page._draw_objects()
+    xz, yz = (dict(s.data) for s in page.obj_sections)
+    assert xz["text"] == ["1", "2"] and xz["x"] == pytest.approx([2.0, 0.0])
+    assert xz["z"] == pytest.approx([12.0, 10.0])
+    assert yz["text"] == ["2"] and yz["x"] == [0.0] and yz["z"] == pytest.approx([10.0])
+
+
+def test_objects_files_of_holoradar_detect_are_read_back(tmp_path):
+    # What `holoradar detect -o` writes (.csv, .json, .geojson) is what the page shows.
+    from holoradar.app.cli.detect import _write
+    from holoradar.app.view.objects import overlay, read_objects
+
+    df = _objects_table()
+    for suffix in (".csv", ".json", ".geojson"):
+        p = tmp_path / f"objects{suffix}"
+        _write(p, df, {"input": "test"}, "scene")
+        back = read_objects(p)
+        assert list(back["kind"]) == ["point", "line", "area"], suffix
+        for c in ("x", "y", "range", "depth", "x_start", "snr_db"):
+            np.testing.assert_allclose(back[c], df[c], rtol=0, atol=0, err_msg=c)
+        ring = overlay(back)["areas"]
+        if suffix == ".geojson":  # the outline travels (closed); elsewhere the rectangle
+            np.testing.assert_allclose(ring["xs"][0], [-8.0, -2.0, -2.0, -8.0, -8.0])
+        else:
+            np.testing.assert_allclose(ring["xs"][0], [-8.0, -2.0, -2.0, -8.0, -8.0])
+            np.testing.assert_allclose(ring["ys"][0], [3.0, 3.0, 7.0, 7.0, 3.0])
+
+
+@pytest.mark.parametrize(("name", "text", "message"), [
+    ("o.txt", "x", r"o.txt: expected an objects table from holoradar detect -o \(.csv"),
+    ("o.json", '{"features": []}', r"o.json: not an objects table"),
+    ("o.csv", "a,b\n1,2\n", r"o.csv: not an objects table .*no column kind, x, y, range"),
+    ("o.geojson", "[1, 2", r"o.geojson: not an objects table"),
+])
+def test_bad_objects_files_are_refused_by_name(tmp_path, scene, name, text, message):
+    from holoradar.app.view.objects import read_objects
+
+    p = tmp_path / name
+    p.write_text(text, encoding="utf-8")
+    with pytest.raises(ValueError, match=message):
+        read_objects(p)
+    paths, _, _ = scene
+    r = CliRunner().invoke(main, ["view", str(paths[0]), "--no-browser", "--objects", str(p)])
+    assert r.exit_code == 2 and "--objects" in r.output and name in r.output
+
+
+def test_find_objects_runs_detect_on_the_plane_shown(scene, tmp_path, monkeypatch):
+    # The page's "Find objects" is holoradar.detect on the plane at the slider with the
+    # look's ground (detect itself is tested in test_detect*.py): plumbing only.
+    from bokeh.document import Document
+
+    import holoradar.analysis.detect as det
+    from holoradar.app.view.page import ViewerPage
+
+    seen = []
+
+    def fake(image, *, medium=None):
+        seen.append((image, medium))
+        return _objects_table()
+
+    monkeypatch.setattr(det, "detect", fake)
+    paths, views, sand = scene
+    S = ViewSession(paths[:1])
+    page = ViewerPage(Document(), S, S.default_settings(ground=SAND).replace(depth=0.1, planes=5),
+                      tmp_path)
+    assert page.obj_table_src.data["n"] == []
+    page.depth.value = 12.0
+    page._find()
+    (image, medium), = seen
+    np.testing.assert_array_equal(
+        image.data, hr.migrate(views[0], 0.42, medium=sand, upsample=4, fov="full").data)
+    assert medium == S.medium(page.s)
+    assert page.obj_table_src.data["n"] == [1, 2, 3]
+    assert "3 object(s) in the plane at depth 12.0 cm" in page.objects_note.text
+    page._find()  # the same plane: cached, not found again
+    assert len(seen) == 1
+    page.which.active = 1  # the mirror-source plane is not the scene
+    page.s = page.s.replace(plane="mirror")
+    page._find()
+    assert "find objects: objects are found in the image plane" in page.status.text

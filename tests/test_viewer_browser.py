@@ -385,3 +385,79 @@ def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, tmp_path):
             assert (pixels.min(axis=-1) < 0.5).sum() > 200, "a blank page"
     finally:
         driver.quit()
+
+
+_ROWS_JS = """
+const doc = Bokeh.documents[0];
+const m = doc.get_model_by_name('objects');
+const v = [...Bokeh.index.all_views()].find(v => v.model === m);
+const root = v.shadow_el || v.el;
+return [m.source.data.n.length, root.querySelectorAll('.slick-row').length];
+"""
+
+
+def _wait_objects(driver, timeout: float = 300.0) -> str:
+    """The objects' note once no search is running."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        note = model_value(driver, "objects_note")
+        if "..." not in note:
+            return note
+        time.sleep(0.1)
+    raise TimeoutError("the page did not finish finding the objects")
+
+
+def test_objects_of_a_file_are_overlaid_and_listed(rod, browser, tmp_path):
+    # A table as `holoradar detect -o objects.csv` writes it (three objects about the rod,
+    # one of each kind): the page lists three rows and its glyphs carry them.
+    import pandas as pd
+
+    from holoradar.analysis.detect.table import COLUMNS
+    from holoradar.app.cli.detect import _write
+
+    path, _, _ = rod
+    nan = float("nan")
+    rows = [{"kind": "point", "x": -0.005, "y": 0.03, "range": 0.40, "depth": 0.10,
+             "snr_db": 14.3},
+            {"kind": "line", "x": -0.005, "y": 0.0, "range": 0.40, "depth": 0.10,
+             "length": 0.12, "width": 0.01, "x_start": -0.005, "y_start": -0.06,
+             "x_end": -0.005, "y_end": 0.06, "snr_db": 15.2},
+            {"kind": "area", "x": -0.16, "y": 0.0, "range": 0.42, "depth": 0.12,
+             "length": 0.05, "width": 0.03, "azimuth_deg": 90.0, "snr_db": 11.4}]
+    df = pd.DataFrame([{c: r.get(c, nan) for c in COLUMNS} for r in rows], columns=COLUMNS)
+    table = tmp_path / "objects.csv"
+    _write(table, df, {}, "scene")
+    with _page(browser, [path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
+                         "--depth", "0.10", "--glare", "off", "--objects", table]):
+        n_data, n_shown = browser.execute_script(_ROWS_JS)
+        assert (n_data, n_shown) == (3, 3)
+        pts = browser.execute_script(
+            "return Bokeh.documents[0].get_model_by_name('objects_points').data.x")
+        assert pts == pytest.approx([-0.5])
+        lines = browser.execute_script(
+            "const d = Bokeh.documents[0].get_model_by_name('objects_lines').data;"
+            "return [d.y0, d.y1];")
+        assert lines == [pytest.approx([-6.0]), pytest.approx([6.0])]
+        _shot(browser, tmp_path, "viewer_detections_file.png")
+        assert not _console_errors(browser)
+
+
+@pytest.mark.slow
+def test_find_objects_lists_what_detect_finds(rod, browser, tmp_path):
+    # --detect: holoradar.detect on the plane shown (the rod 10 cm deep, its glare
+    # removed by the image-source method); the page lists exactly the API's objects.
+    path, h, sand = rod
+    with _page(browser, [path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface", "0.30",
+                         "--depth", "0.10", "--glare", "image_source", "--detect"]):
+        note = _wait_objects(browser)
+        cleaned, _ = hr.suppress_surface(h, sand, h.source, "image_source")
+        img = hr.migrate(cleaned, 0.40, medium=sand, upsample=4, fov="full")
+        api = hr.detect(img, medium=sand)
+        assert f"{len(api)} object(s) in the plane at depth 10.0 cm" in note
+        n_data, n_shown = browser.execute_script(_ROWS_JS)
+        assert n_data == len(api) and n_shown == min(len(api), 5) and len(api) > 0
+        xs = browser.execute_script(
+            "return Bokeh.documents[0].get_model_by_name('objects_labels').data.x")
+        np.testing.assert_allclose(xs, api["x"] * 100, rtol=0, atol=1e-9)
+        _shot(browser, tmp_path, "viewer_detections.png")
+        assert not _console_errors(browser)

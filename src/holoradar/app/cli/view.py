@@ -75,20 +75,28 @@ def ground_from_options(spec: dict[str, Any], frequency: float | None) -> dict[s
               help="Folder for the page's exports (default: the current folder).")
 @click.option("--browser/--no-browser", default=True, show_default=True,
               help="Open the page in the default browser.")
+@click.option("--objects", "objects_file", default=None,
+              type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="Overlay and list the objects of a table written by `holoradar detect "
+                   "-o` (.csv, .json or .geojson), in the same coordinates as the image.")
+@click.option("--detect", "find", is_flag=True,
+              help="Find the objects in the first plane shown (as the page's 'Find "
+                   "objects' button): overlaid and listed.")
 @layout_option
 @output_options
 def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Path | None,
          depth: float | None, glare: str | None, host: str, port: int,
-         export_dir: Path | None, browser: bool, layout: str | None, check: bool,
-         report: Reporter) -> None:
+         export_dir: Path | None, browser: bool, objects_file: Path | None, find: bool,
+         layout: str | None, check: bool, report: Reporter) -> None:
     """Look at holograms, images or a survey in the browser, turning the knobs live.
 
     FILES: holograms (one per view of the scene: they are summed), or one
     image/volume file, or one survey store (.zarr). The page sweeps depth,
     removes the surface glare, sums views, shows sections, the spectral window,
-    a cursor readout and distances, and exports a PNG, the image (NetCDF) and
-    the settings (TOML; `holoradar render` reproduces the image from it).
-    Serves until Ctrl+C.
+    a cursor readout and distances, finds the objects in the plane shown (or
+    shows those of --objects) as numbered markers and a list, and exports a PNG,
+    the image (NetCDF) and the settings (TOML; `holoradar render` reproduces the
+    image from it). Serves until Ctrl+C.
     """
     from ..view.server import open_in_browser, url_of
     from ..view.session import ViewSession
@@ -102,6 +110,14 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
     for p in paths:
         if not p.exists():
             raise click.BadParameter(f"{p} does not exist", param_hint="FILES")
+    objects = None
+    if objects_file is not None:
+        from ..view.objects import read_objects
+
+        try:
+            objects = read_objects(objects_file)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc), param_hint="--objects") from None
     session = ViewSession(paths, layout=layout, check=check)
     freq = float(np.mean(session.frequencies)) if session.frequencies.size else None
     ground = ground_from_options(medium_spec, freq)
@@ -137,7 +153,7 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
         # brightest point's depth, unless asked otherwise
         s = session.opening_settings(s, glare=glare is None, depth=depth is None)
     session.medium(s)  # a bad ground fails here, before the server starts
-    server = _serve(session, s, host, port, export_dir)
+    server = _serve(session, s, host, port, export_dir, objects, find)
     url = url_of(server, host)
     report.done({"url": url, "files": [str(p) for p in paths]},
                 [f"holoradar view: serving {url} (Ctrl+C to stop)"])
@@ -170,7 +186,8 @@ def _check_depth(session: Any, s: Any, depth: float, check: bool) -> None:
                      if surface else None, offset=surface)
 
 
-def _serve(session: Any, s: Any, host: str, port: int, export_dir: Path | None) -> Any:
+def _serve(session: Any, s: Any, host: str, port: int, export_dir: Path | None,
+           objects: Any = None, find: bool = False) -> Any:
     """The started server, or a click error naming ``--host`` or ``--port``."""
     import errno
     import socket
@@ -178,7 +195,8 @@ def _serve(session: Any, s: Any, host: str, port: int, export_dir: Path | None) 
     from ..view.server import make_server
 
     try:
-        return make_server(session, s, host=host, port=port, export_dir=export_dir)
+        return make_server(session, s, host=host, port=port, export_dir=export_dir,
+                           objects=objects, find=find)
     except ValueError as exc:
         raise click.BadParameter(str(exc).removeprefix("host: "), param_hint="--host") from None
     except OSError as exc:

@@ -88,10 +88,16 @@ class ViewerPage:
     ground_file : Mapping, optional
         A layered ground offered as a choice; default the layered ground of
         ``settings`` (from a medium file, ``--layers`` or a saved look).
+    objects : pandas.DataFrame, optional
+        Objects to overlay and list from the start (a table of
+        :func:`holoradar.detect`, e.g. read by :func:`.objects.read_objects`).
+    find : bool
+        Find the objects in the first plane shown (as the *Find objects* button).
     """
 
     def __init__(self, doc: Any, session: ViewSession, settings: ViewSettings,
-                 export_dir: Path, ground_file: dict[str, Any] | None = None) -> None:
+                 export_dir: Path, ground_file: dict[str, Any] | None = None,
+                 objects: Any = None, find: bool = False) -> None:
         self.doc = doc
         self.session = session
         self.s = settings
@@ -105,8 +111,15 @@ class ViewerPage:
         self.pending_full = False
         self._syncing = False  # True while the page itself moves its widgets
         self._full_ok = True  # the last sweep (sections, colour scale) succeeded
+        self.objects = objects
+        self.section_at: tuple[float, float] | None = None  # x, y (m) of the sections
         self._build()
         self._full()
+        if objects is not None:
+            self.objects_note.text = f"{len(objects)} object(s) from the file"
+        self._draw_objects()
+        if find:
+            self._schedule_find()
 
     # ------------------------------------------------------------------ layout
     def _build(self) -> None:
@@ -220,6 +233,11 @@ class ViewerPage:
                          sizing_mode="stretch_width")
         clear = Button(label="clear points", width=100, name="clear")
         clear.on_click(lambda: self._clear_points())
+        # objects: found in the plane shown, or read from a file (--objects)
+        self.find = Button(label="Find objects", width=120, name="find_objects",
+                           button_type="primary")
+        self.find.on_click(lambda _e=None: self._schedule_find())
+        self.objects_note = Div(text="", name="objects_note", width=CONTROLS_WIDTH - 140)
         # export
         self.exported = Div(text="", name="exported", width=CONTROLS_WIDTH - 10)
         buttons = []
@@ -275,6 +293,7 @@ class ViewerPage:
             sp = Span(location=0, dimension="width", line_color="cyan", line_dash="dashed")
             f.add_layout(sp)
             self.depth_marks.append(sp)
+        self._build_objects()
         # hologram and spectral window of one view
         self.holo_view = Select(title="hologram of view", options=[(str(i), n) for i, n in
                                                                    enumerate(names)],
@@ -329,9 +348,11 @@ class ViewerPage:
             row(self.ground_kind, self.surface), row(self.eps_re, self.eps_im),
             self.glare, self.direct, self.glare_report, self.which,
             Div(text="<b>views</b>"), self.views, row(self.mode, self.freq), self.frame,
-            row(self.scale, self.db_range), self.click, clear, row(*buttons[:2]),
+            row(self.scale, self.db_range), self.click, clear,
+            row(self.find, self.objects_note), row(*buttons[:2]),
             buttons[2], self.exported, width=CONTROLS_WIDTH)
-        readouts = column(self.readout, self.ruler, sizing_mode="stretch_width")
+        readouts = column(self.readout, self.ruler, self.obj_table,
+                          sizing_mode="stretch_width")
         # The hologram row only where holograms were opened (an image has none).
         holo_row = row(column(self.holo_view, self.hfigs[0], sizing_mode="stretch_width",
                               max_width=320),
@@ -578,6 +599,8 @@ class ViewerPage:
         self.xz.title.text = f"x-z section at y = {_cm(y, 1)} cm"
         self.yz.title.text = f"y-z section at x = {_cm(x, 1)} cm"
         self.vline.location, self.hline.location = x * CM, y * CM
+        self.section_at = (float(x), float(y))
+        self._draw_objects()
 
     def _holo(self) -> None:
         S, s = self.session, self.s
@@ -652,6 +675,107 @@ class ViewerPage:
         self.points = []
         self.marks.data = {"x": [], "y": []}
         self.ruler.text = "distance: click two points"
+
+    # ------------------------------------------------------------- objects
+    def _build_objects(self) -> None:
+        """The objects' glyphs on the plan view and the sections, and their list."""
+        from bokeh.models import ColumnDataSource, DataTable, TableColumn
+
+        from .objects import TABLE_FIELDS, overlay, section_marks, table_rows
+
+        empty = overlay(None)
+        self.obj_src = {k: ColumnDataSource(data=v, name=f"objects_{k}")
+                        for k, v in empty.items()}
+        colour = "#39ff14"
+        f = self.fig
+        f.patches("xs", "ys", source=self.obj_src["areas"], fill_color=colour,
+                  fill_alpha=0.12, line_color=colour, line_width=2)
+        f.segment("x0", "y0", "x1", "y1", source=self.obj_src["lines"], line_color=colour,
+                  line_width=3)
+        f.scatter("x", "y", source=self.obj_src["points"], marker="circle", size=16,
+                  fill_alpha=0.0, line_color=colour, line_width=2)
+        f.text("x", "y", text="text", source=self.obj_src["labels"], text_color=colour,
+               text_font_size="11pt", text_font_style="bold", x_offset=8, y_offset=-8)
+        xz, yz = section_marks(None, 0.0, (0.0, 0.0), 0.0)
+        self.obj_sections = []
+        for fig, data in ((self.xz, xz), (self.yz, yz)):
+            src = ColumnDataSource(data=data, name=f"objects_{fig.name}")
+            fig.scatter("x", "z", source=src, marker="circle", size=12, fill_alpha=0.0,
+                        line_color=colour, line_width=2)
+            fig.text("x", "z", text="text", source=src, text_color=colour,
+                     text_font_size="10pt", text_font_style="bold", x_offset=7, y_offset=-7)
+            self.obj_sections.append(src)
+        self.obj_table_src = ColumnDataSource(data=table_rows(None, 0.0),
+                                              name="objects_source")
+        self.obj_table = DataTable(
+            source=self.obj_table_src, name="objects", height=160, index_position=None,
+            sizing_mode="stretch_width", selectable=True, sortable=False,
+            columns=[TableColumn(field=k, title=t, width=40 if k == "n" else 90)
+                     for k, t in TABLE_FIELDS])
+        self.obj_table_src.selected.on_change("indices", lambda _a, _o, n: self._goto(n))
+
+    def _draw_objects(self) -> None:
+        """Fill the objects' sources from ``self.objects`` for the look shown."""
+        from .objects import overlay, section_marks, table_rows
+
+        df = self.objects
+        surface = self.session.surface(self.s) if self.session.kind == "holograms" else 0.0
+        for k, v in overlay(df).items():
+            self.obj_src[k].data = v
+        if self.section_at is not None:
+            near = self._near()
+            for src, data in zip(self.obj_sections,
+                                 section_marks(df, surface, self.section_at, near),
+                                 strict=True):
+                src.data = data
+        self.obj_table_src.data = table_rows(df, surface)
+
+    def _near(self) -> float:
+        """How far from a section an object is marked on it: half a resolution cell
+        of the detection (a table from a file: the plan view's 2 pixels, or 1 cm)."""
+        cell = (self.objects.attrs.get("resolution_cell") if self.objects is not None
+                else None)
+        if cell is not None and len(cell) >= 2 and all(map(math.isfinite, cell[:2])):
+            return 0.5 * max(float(cell[0]), float(cell[1]))
+        vol = self.volume
+        if vol is not None and vol.x.size > 1:
+            return max(2 * abs(float(vol.x[1] - vol.x[0])), 0.01)
+        return 0.01
+
+    def _schedule_find(self) -> None:
+        self.objects_note.text = "finding objects ..."
+        self.doc.add_next_tick_callback(self._find)
+
+    def _find(self) -> None:
+        def work() -> None:
+            # the plane at the slider, even while its picture is still on its way
+            self.s = self.s.replace(depth=float(self.depth.value) / CM)
+            df = self.session.objects(self.s)
+            self.objects = df
+            self._draw_objects()
+            where = "depth" if self.s.ground is not None else "range"
+            self.objects_note.text = (f"{len(df)} object(s) in the plane at {where} "
+                                      f"{float(self.depth.value):.1f} cm")
+
+        if not self._guard(work, "find objects: "):
+            self.objects_note.text = ""
+
+    def _goto(self, indices: list[int]) -> None:
+        """A chosen row: the slider to its object's depth, the sections through it."""
+        if not indices:
+            return
+        data = self.obj_table_src.data
+        i = int(indices[0])
+        at, x, y = data["at"][i], data["x_m"][i], data["y_m"][i]
+        if at is None or not math.isfinite(at):
+            return
+        if not self.depth.start <= at <= self.depth.end:
+            # beyond the sweep: widen it (the spinners redo the sweep)
+            self.sweep_a.value = round(min(self.depth.start, at), 3)
+            self.sweep_b.value = round(max(self.depth.end, at), 3)
+        self.depth.value = at
+        if math.isfinite(x) and math.isfinite(y):
+            self._set(section=(float(x), float(y)))
 
     # ------------------------------------------------------------- export
     def _export(self, what: str) -> None:

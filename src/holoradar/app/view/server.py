@@ -42,7 +42,8 @@ def is_loopback(host: str) -> bool:
 
 def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "127.0.0.1",
                 port: int = 0, export_dir: Path | None = None,
-                ground_file: dict[str, Any] | None = None) -> Any:
+                ground_file: dict[str, Any] | None = None, objects: Any = None,
+                find: bool = False) -> Any:
     """A started ``bokeh.server.server.Server`` showing ``session`` at ``/``.
 
     Parameters
@@ -56,6 +57,10 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
         0 (default): a free port chosen by the system (``server.port``).
     export_dir : Path
         Where the page's export buttons write; default the current folder.
+    objects : pandas.DataFrame, optional
+        Objects overlaid and listed from the start (``holoradar detect``'s table).
+    find : bool
+        Each new tab finds the objects in its first plane.
 
     Returns
     -------
@@ -87,7 +92,7 @@ def make_server(session: ViewSession, settings: ViewSettings, *, host: str = "12
     folder = Path.cwd() if export_dir is None else Path(export_dir)
 
     def make_doc(doc: Any) -> None:
-        ViewerPage(doc, session, settings, folder, ground_file)
+        ViewerPage(doc, session, settings, folder, ground_file, objects=objects, find=find)
 
     app = Application(FunctionHandler(make_doc))
     # A free port is found, then bound by the server: another program may take it in

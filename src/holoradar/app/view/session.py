@@ -179,6 +179,7 @@ class ViewSession:
         self._clean = _Cache(8)
         self._planes = _Cache(256)
         self._sweeps = _Cache(4)
+        self._objects = _Cache(16)
 
     def _init_survey(self) -> None:
         from ...survey.reader import open_survey
@@ -479,6 +480,38 @@ class ViewSession:
                 return migrate(views[i], zm, upsample=s.upsample, fov=s.fov)
 
         return self._planes.get(("mirror", self._glare_key(s), i, s.upsample, s.fov), make)
+
+    def objects(self, s: ViewSettings) -> Any:
+        """The objects in the plane shown for ``s``: :func:`holoradar.detect` on it, with
+        the look's ground (depths below its surface; none without a ground).
+
+        Returns
+        -------
+        pandas.DataFrame
+            detect's table (cached per plane and look).
+
+        Raises
+        ------
+        ValueError
+            The mirror-source plane (the glare's focus, not the scene), or what
+            detect refuses.
+        """
+        if self.kind == "holograms" and s.plane == "mirror":
+            raise ValueError("objects are found in the image plane, not the mirror-source "
+                             "plane: choose 'image plane'")
+        if self.kind == "holograms":
+            key: tuple[Any, ...] = (self._key(s), round(self.surface(s) + s.depth, 12))
+        else:
+            key = (self.kind, round(s.depth, 12))
+
+        def find() -> Any:
+            from ...analysis.detect import detect
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", AliasingWarning)
+                return detect(self.image(s), medium=self.medium(s))
+
+        return self._objects.get(key, find)
 
     def hologram(self, s: ViewSettings, view: int) -> Hologram:
         """One view as imaged (chosen frequency, glare removed if asked), 2-D: a wideband
