@@ -50,6 +50,7 @@ from ..physics.propagation import (
     spectral_axes,
 )
 from .kspace import _pad_axis
+from .oblique_nufft import spectrum_nufft
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -93,12 +94,19 @@ def ground_grid(hologram: Hologram, zs: np.ndarray, medium: Medium,
 
 def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
                    x: Any = None, y: Any = None, pad: Any = True, upsample: int = 1,
-                   compensate_loss: float | None = None, dtype: Any = None) -> Image:
+                   compensate_loss: float | None = None, dtype: Any = None,
+                   route: str = "auto") -> Image:
     """Single-frequency image of a posed hologram on horizontal world planes ``zs``.
 
     ``compensate_loss``: the SNR in dB that limits the loss compensation, or None
-    for the plain adjoint. Returns an Image in the world frame, data (..., nz, ny, nx).
+    for the plain adjoint. ``route``: how the data's spectrum on the reference plane
+    is summed: ``"direct"`` (the factored sums, exact to rounding), ``"nufft"``
+    (finufft, relative error ``oblique_nufft.EPS``: 1e-6 in complex128, 1e-5 in
+    complex64) or ``"auto"`` (the faster as measured, :func:`choose_route`).
+    Returns an Image in the world frame, data (..., nz, ny, nx).
     """
+    if route not in ("auto", "nufft", "direct"):
+        raise ValueError(f"route must be 'auto', 'nufft' or 'direct', got {route!r}")
     k = hologram.k
     mono = hologram.monostatic
     pts = hologram.points
@@ -154,7 +162,8 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
         grid = tuple(max(m, sfft.next_fast_len(int(np.ceil(4 * r / d)), real=False))
                      for m, r, d in zip(grid, reach[::-1], (dcy, dcx), strict=True))
     shifted = _shifted(medium, z_ref)
-    H = _spectrum_on_plane(hologram, grid, (dcx, dcy), (xo[0], yo[0], z_ref), work, gap)
+    H = _spectrum_on_plane(hologram, grid, (dcx, dcy), (xo[0], yo[0], z_ref), work, gap,
+                           route)
     out = np.empty((*H.shape[:-2], zs.size, yo.size, xo.size), dtype=work)
     workers = -1 if grid[0] * grid[1] * ux * uy >= 128 * 128 else 1
     for j, z in enumerate(zs):
@@ -262,14 +271,23 @@ def _shifted(medium: Medium, z_ref: float) -> Medium:
 
 def _spectrum_on_plane(hologram: Hologram, grid: tuple[int, int], pitch: tuple[float, float],
                        origin: tuple[float, float, float], work: np.dtype,
-                       gap: float) -> np.ndarray:
+                       gap: float, route: str = "auto") -> np.ndarray:
     """``H(k)`` on the (My, Mx) world grid: the adjoint of the plane-wave field at the
-    elements (module docstring), for every leading frame of ``hologram.data``."""
+    elements (module docstring), for every leading frame of ``hologram.data``.
+
+    ``route``: ``"direct"`` (the factored sums below, exact to rounding), ``"nufft"``
+    (:func:`.oblique_nufft.spectrum_nufft`, finufft to its ``EPS``) or ``"auto"``
+    (:func:`choose_route`).
+    """
     My, Mx = grid
     k = hologram.k
     kk = 2 * k if hologram.monostatic else k
     pose = hologram.pose
     reach = -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12)   # largest Im(kz) kept
+    if route == "auto":
+        route = choose_route(grid, pose, hologram.data.shape[-2:])
+    if route == "nufft":
+        return spectrum_nufft(hologram, grid, pitch, origin, work, reach)
     key = ("ground-basis", grid, pitch, origin, kk, pose, hologram.x.tobytes(),
            hologram.y.tobytes(), work.str, round(reach, 6))
     basis = _CACHE.get(key, lambda: _Remap.build(grid, pitch, origin, kk, pose, hologram.x,
@@ -296,6 +314,46 @@ def _spectrum_on_plane(hologram: Hologram, grid: tuple[int, int], pitch: tuple[f
     H = np.zeros((d.shape[0], My * Mx), dtype=work)
     H[:, basis.index] = vals
     return H.reshape((*lead, My, Mx))
+
+
+#: The direct route's multiply-adds up to which it stays the default (its cost grows
+#: as the grid times the elements, finufft's about as the grid): measured faster than
+#: finufft below, slower above (benchmarks/results_oblique.json, docs/oblique.md).
+DIRECT_MAX_PRODUCTS = 2**19
+
+
+def choose_route(grid: tuple[int, int], pose: Any, shape: tuple[int, int]) -> str:
+    """The faster route of the spectrum's sum, as measured (``docs/oblique.md``).
+
+    The direct sums cost ``My Mx ny + Mx nx ny`` multiply-adds when the aperture's
+    ``x'`` lies along the world's ``x`` (azimuth 90 degrees, or level), ``My Mx nx +
+    My nx ny`` when ``y'`` lies along ``y`` (azimuth 0) and ``My Mx nx ny`` otherwise;
+    they are chosen while that stays under :data:`DIRECT_MAX_PRODUCTS`, finufft above.
+
+    Parameters
+    ----------
+    grid : (My, Mx)
+        The world FFT grid.
+    pose : Pose
+        The aperture's pose.
+    shape : (ny, nx)
+        The aperture's elements.
+
+    Returns
+    -------
+    str
+        ``"direct"`` or ``"nufft"``.
+    """
+    u, v = pose.u, pose.v
+    ny, nx = shape
+    My, Mx = grid
+    if u[1] == 0 and u[2] == 0:
+        products = My * Mx * ny + Mx * nx * ny
+    elif v[0] == 0 and v[2] == 0:
+        products = My * Mx * nx + My * nx * ny
+    else:
+        products = My * Mx * nx * ny
+    return "direct" if products <= DIRECT_MAX_PRODUCTS else "nufft"
 
 
 def _dense(values: np.ndarray, index: np.ndarray, grid: tuple[int, int]) -> np.ndarray:
@@ -328,7 +386,15 @@ class _Remap:
         index = np.flatnonzero(keep)
         K = np.stack([P.ravel()[index], Q.ravel()[index], -np.conj(kz[index])], axis=1)
         u, v = pose.u, pose.v
-        c = np.asarray(pose.center) - np.asarray(origin)
+        # Element coordinates counted from the lowest corner (largest z): every factor of
+        # an evanescent component then has a modulus of at most 1 (counted from the
+        # centre, the two halves' factors reach exp(+-Im(kz) rise / 2), beyond complex64's
+        # range for a tall aperture close to the ground).
+        x0 = xl[-1] if u[2] > 0 else xl[0]
+        y0 = yl[-1] if v[2] > 0 else yl[0]
+        a, b = xl - x0, yl - y0
+        c = np.asarray(pose.center) + x0 * np.asarray(u) + y0 * np.asarray(v) \
+            - np.asarray(origin)
         # An aperture axis along a world axis (azimuth 0 or 90 degrees, or level):
         # its phase depends on one grid index, and the sum over it is a small
         # product per grid row or column (the common layouts, several times faster).
@@ -336,22 +402,22 @@ class _Remap:
         phase = np.exp(-1j * (K @ c))
         if u[1] == 0 and u[2] == 0:
             mode = "columns"
-            ea = np.exp(-1j * np.outer(p * u[0], xl))                 # (Mx, nx)
+            ea = np.exp(-1j * np.outer(p * u[0], a))                  # (Mx, nx)
             eb = np.zeros((Mx * My, yl.size), complex)               # (Mx, My, ny)
-            eb[(index % Mx) * My + index // Mx] = np.exp(-1j * np.outer(K @ v, yl))
+            eb[(index % Mx) * My + index // Mx] = np.exp(-1j * np.outer(K @ v, b))
             eb = eb.reshape(Mx, My, yl.size)
             phase = _dense(phase, index, grid)
         elif v[0] == 0 and v[2] == 0:
             mode = "rows"
             ea = np.zeros((My * Mx, xl.size), complex)               # (My, Mx, nx)
-            ea[index] = np.exp(-1j * np.outer(K @ u, xl))
+            ea[index] = np.exp(-1j * np.outer(K @ u, a))
             ea = ea.reshape(My, Mx, xl.size)
-            eb = np.exp(-1j * np.outer(q * v[1], yl))                 # (My, ny)
+            eb = np.exp(-1j * np.outer(q * v[1], b))                  # (My, ny)
             phase = _dense(phase, index, grid)
         else:
             mode = "full"
-            ea = np.exp(-1j * np.outer(K @ u, xl))
-            eb = np.exp(-1j * np.outer(K @ v, yl))
+            ea = np.exp(-1j * np.outer(K @ u, a))
+            eb = np.exp(-1j * np.outer(K @ v, b))
         ea, eb, phase = ea.astype(work), eb.astype(work), phase.astype(work)
         for a in (index, ea, eb, phase):
             a.setflags(write=False)
