@@ -20,7 +20,11 @@ interpolation, hence no Jacobian to carry: the remapping of the aperture's
 spectral coordinates ``(K.u, K.v)`` onto the world's ``(p, q)`` is implicit).
 With element coordinates ``(x'_j, y'_i)`` on the aperture's own axes ``u``,
 ``v`` it factors: ``H(k) = exp(-i K.(c - r0)) sum_i exp(-i y'_i K.v)
-sum_j d_ij exp(-i x'_j K.u)``: two small matrix products. From ``H`` on the
+sum_j d_ij exp(-i x'_j K.u)``: two small matrix products (the "direct" route).
+The same sum is a type-2 non-uniform FFT of the data at the points ``(K.v dy',
+K.u dx')`` for the components that travel in the air (the "nufft" route,
+:mod:`.oblique_nufft`, finufft); :func:`choose_route` takes the faster, as
+measured (the direct sums for small grids and arrays). From ``H`` on the
 reference plane the usual exact migration carries every component down through
 the layers (``conj`` of the transfer, loss compensation, band limit) onto
 horizontal planes at world ranges ``z``: one inverse FFT per plane.
