@@ -225,7 +225,7 @@ def large() -> dict:
     res = {"floor_ms": 1e3 * float(np.median(fl)), "warm_ms": 1e3 * float(np.median(mig)),
            "warm_ratio": float(np.median(np.array(mig) / np.array(fl))), **mem,
            **wideband_extras("wideband_large")}
-    print("wideband_large", {k: round(v, 4) for k, v in res.items()}, flush=True)
+    print("wideband_large", {k: float(f"{v:.3g}") for k, v in res.items()}, flush=True)
     return res
 
 
@@ -274,7 +274,7 @@ def main(cases: tuple[str, ...] = CASES) -> dict:
                      "pairs": len(ratios)}
         if case in WIDEBAND:
             res[case].update(wideband_extras(case))
-        print(case, {k: round(v, 4) for k, v in res[case].items()}, flush=True)
+        print(case, {k: float(f"{v:.3g}") for k, v in res[case].items()}, flush=True)
     return res
 
 

@@ -49,6 +49,7 @@ sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 __all__ = ["ERROR_BOUND", "OVERSAMPLE", "check_applicable", "migrate_stolt"]
 
 OVERSAMPLE = 4   # kz grid points per plane
+_GRID_BYTES = 1 << 25   # the kz grids of a block of columns (complex128)
 ERROR_BOUND = (9 / 16) / 24 * (np.pi / OVERSAMPLE) ** 4   # per plane wave: 0.0089
 
 
@@ -137,7 +138,12 @@ def migrate_stolt(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: n
     # The rest (evanescent, or dropped by the band limit before the last plane) are few
     # and summed exactly, plane by plane.
     full = (np.abs(np.abs(step) - 1) < 1e-6) & (jm >= nz - 1)
+    gridded = np.flatnonzero(full.any(axis=0))      # columns with resampled terms
     rest_f, rest_c = np.nonzero((jm >= 0) & ~full)
+    reach = jm[rest_f, rest_c]
+    by_reach = np.argsort(-reach, kind="stable")   # the terms a plane needs: a prefix
+    rest_f, rest_c = rest_f[by_reach], rest_c[by_reach]
+    n_on = np.searchsorted(-reach[by_reach], -np.arange(nz), side="right")
     gain = np.where(jm >= 0, gain_q[:, q_idx], 0)
     theta = np.mod(-np.angle(step), 2 * np.pi)   # phase per plane, [0, 2 pi)
     M = OVERSAMPLE * nz
@@ -147,7 +153,7 @@ def migrate_stolt(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: n
     t = u - m0
     nodes = [(-1, -t * (t - 1) * (t - 2) / 6), (0, (t + 1) * (t - 1) * (t - 2) / 2),
              (1, -(t + 1) * t * (t - 2) / 2), (2, (t + 1) * t * (t - 1) / 6)]
-    centre = np.exp(-1j * theta * jc)          # the phase referred to the middle plane
+    weight = np.where(full, np.exp(-1j * theta * jc), 0)   # phase referred to the middle
     data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
     batch = data.shape[:-3]
     data = data.reshape((-1, *data.shape[-3:]))
@@ -155,30 +161,39 @@ def migrate_stolt(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: n
     oy, ox = up * (ny - 1) + 1, up * (nx - 1) + 1
     out = np.empty((data.shape[0], nz, oy, ox), dtype=work)
     nc = live.size
-    col = np.arange(nc)[None, :] * M
+    rows_z = np.mod(np.arange(nz) - jc, M)
+    per = max(1, _GRID_BYTES // (16 * M))             # gridded columns per block
     for b in range(data.shape[0]):
         A = np.empty((hologram.nf, nc), dtype=np.complex128)
         for i in range(hologram.nf):
             H = sfft.fft(data[b, i].astype(work, copy=False), n=Mx, axis=-1, workers=workers)
             H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
             A[i] = H.reshape(-1)[live] * gain[i] * w[i]
-        a, s_rest, j_rest = A[rest_f, rest_c], step[rest_f, rest_c], jm[rest_f, rest_c]
-        A = np.where(full, A * centre, 0)
-        G = np.zeros(nc * M, dtype=np.complex128)
-        for shift, wt in nodes:
-            idx = (col + np.mod(m0 + shift, M)).ravel()
-            vals = (A * wt).ravel()
-            G += np.bincount(idx, vals.real, nc * M) + 1j * np.bincount(idx, vals.imag, nc * M)
-        # sum_m G_m exp(-2 pi i m (j - jc) / M): the forward FFT at (j - jc) mod M.
-        F = sfft.fft(G.reshape(nc, M).astype(work), axis=-1, workers=workers)
+        Fz = np.zeros((nz, nc), dtype=work)
+        for c0 in range(0, gridded.size, per):
+            cols = gridded[c0:c0 + per]
+            Ab = A[:, cols] * weight[:, cols]
+            base = np.arange(cols.size)[None, :] * M
+            G = np.zeros(cols.size * M, dtype=np.complex128)
+            for shift, wt in nodes:
+                idx = (base + np.mod(m0[:, cols] + shift, M)).ravel()
+                vals = (Ab * wt[:, cols]).ravel()
+                G.real += np.bincount(idx, vals.real, G.size)
+                G.imag += np.bincount(idx, vals.imag, G.size)
+            # sum_m G_m exp(-2 pi i m (j - jc) / M): the forward FFT at (j - jc) mod M.
+            F = sfft.fft(G.reshape(cols.size, M), axis=-1, workers=workers, overwrite_x=True)
+            Fz[:, cols] = F[:, rows_z].T
+        a, s_rest = A[rest_f, rest_c].astype(work), step[rest_f, rest_c]
+        for j in range(nz):   # the rest, summed exactly (live ones a shrinking prefix)
+            k = int(n_on[j])
+            if k == 0:
+                break
+            Fz[j] += np.bincount(rest_c[:k], a[:k].real, nc) + 1j * np.bincount(
+                rest_c[:k], a[:k].imag, nc)
+            a[:k] *= s_rest[:k]
         spec = np.zeros((nz, My * Mx), dtype=work)
-        Fz = F[:, np.mod(np.arange(nz) - jc, M)].T          # (nz, nc)
-        for j in range(nz):   # the exactly summed rest
-            on = j_rest >= j
-            Fz[j] += np.bincount(rest_c[on], a[on].real, nc) + 1j * np.bincount(
-                rest_c[on], a[on].imag, nc)
-            a *= s_rest
         spec[:, live] = Fz
+        del Fz
         spec = spec.reshape(nz, My, Mx)
         if up > 1:
             spec = kspace._pad_axis(kspace._pad_axis(spec, up, -1), up, -2)
