@@ -20,7 +20,10 @@ to rounding: the recurrence's error grows by one rounding per step, ``~j eps``
 (``eps`` = 6e-8 in complex64, 1.1e-16 in complex128).
 
 numba is imported on the first call (not with holoradar); its compiled loop is cached
-on disk (``cache=True``) next to this module, or under ``NUMBA_CACHE_DIR``.
+on disk (``cache=True``) next to this module (numba's own cache: it is written whether
+or not Python writes bytecode, ``PYTHONDONTWRITEBYTECODE``), or under
+``NUMBA_CACHE_DIR`` where the package's folder is read-only. :func:`warm` builds or
+loads it ahead of the first call.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ from . import kspace
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
-__all__ = ["available", "migrate_columns", "output_bytes"]
+__all__ = ["available", "migrate_columns", "output_bytes", "warm"]
 
 _COLS = 256          # components per block of the compiled loop (its terms stay in cache)
 _THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
@@ -143,6 +146,22 @@ def _kernel() -> Any:
                 j += k
 
     return column_sum
+
+
+def warm() -> None:
+    """Import numba and load (or, the first time, compile and cache) the compiled loop in
+    both precisions, so that the next wideband ``migrate`` does not pay for it.
+
+    For a long-lived process (a viewer, a server) to call at start-up, e.g. in a
+    background thread; and once after installing, to build the on-disk cache (the
+    first compilation takes seconds, loading it later a fraction of one).
+    """
+    kernel = _kernel()
+    for real in (np.float32, np.float64):
+        z = np.zeros((1, 1, _COLS), dtype=real)
+        kernel(z, z.copy(), z.copy(), z.copy(), np.zeros((1, 1, _COLS), np.int32),
+               np.zeros(1, np.int32), np.zeros((1, _COLS), np.int64), np.zeros(1, np.int64),
+               0, 0, 1, real(0), np.zeros((1, 2), dtype=real))
 
 
 def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int, j1: int,
