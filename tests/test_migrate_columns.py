@@ -28,12 +28,12 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(a - b) / np.linalg.norm(b))
 
 
-def _hologram(mono: bool, medium: hr.Medium | None, measured: bool, dtype: type
-              ) -> hr.Hologram:
+def _hologram(mono: bool, medium: hr.Medium | None, measured: bool, dtype: type,
+              n: int = 24) -> hr.Hologram:
     """Two points (simulated, exact Green's functions); ``measured``: as a device
     records them, with the ground's reflection, noise (20 dB), a phase response across
     the band, then the mean removed as one does with such data."""
-    ap = hr.Aperture.grid(24, 0.0062 if mono else 0.0124, monostatic=mono)
+    ap = hr.Aperture.grid(n, 0.0062 if mono else 0.0124, monostatic=mono)
     med = medium if medium is not None else hr.Medium.free_space()
     scene = hr.Scene(med, targets=[hr.PointTarget((0.01, 0.0, 0.25)),
                                    hr.PointTarget((-0.03, 0.02, 0.21))],
@@ -91,14 +91,14 @@ def test_auto_takes_the_compiled_loop_and_the_numpy_sum_without_numba(monkeypatc
 def test_auto_falls_back_to_the_per_frequency_sum_where_the_phase_shift_cannot():
     # Planes not uniform, or a lossy ground to compensate: "auto" silently sums
     # frequency by frequency (the same code path as "frequency", bit for bit).
-    h = _hologram(True, None, False, np.complex128)
+    h = _hologram(True, None, False, np.complex128, n=12)
     zs = np.array([0.2, 0.21, 0.23])
     a = hr.migrate(h, zs)
     b = hr.migrate(h, zs, algorithm="frequency")
     np.testing.assert_array_equal(a.data, b.data)
     lossy = hr.Medium.layered([0.10, 0.13], [5.0 + 0.5j, 8.0 + 0.3j])
-    a = hr.migrate(h, ZS, medium=lossy)
-    b = hr.migrate(h, ZS, medium=lossy, algorithm="frequency")
+    a = hr.migrate(h, ZS[::4], medium=lossy)
+    b = hr.migrate(h, ZS[::4], medium=lossy, algorithm="frequency")
     np.testing.assert_array_equal(a.data, b.data)
 
 

@@ -29,8 +29,9 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(a - b) / np.linalg.norm(b))
 
 
-def _hologram(mono: bool, medium: hr.Medium | None, source=None) -> hr.Hologram:
-    ap = hr.Aperture.grid(24, 0.0062 if mono else 0.0124, monostatic=mono)
+def _hologram(mono: bool, medium: hr.Medium | None, source=None, n: int = 24
+              ) -> hr.Hologram:
+    ap = hr.Aperture.grid(n, 0.0062 if mono else 0.0124, monostatic=mono)
     med = medium if medium is not None else hr.Medium.free_space()
     kw = {} if mono else {"source": hr.PlaneWave() if source is None else source}
     scene = hr.Scene(med, targets=[hr.PointTarget((0.01, 0.0, 0.25)),
@@ -71,13 +72,14 @@ def test_stolt_is_within_its_bound_of_the_phase_shift_sum(mono, medium):
 
 
 def test_stolt_refuses_what_it_cannot_do_and_auto_falls_back():
-    h = _hologram(True, None)
+    h = _hologram(True, None, n=12)
+    zs = ZS[::4]
     cases = [
         (dict(z=[0.2, 0.21, 0.23]), "uniformly spaced planes"),
         (dict(z=np.linspace(0.1, 0.2, 11), medium=HALF), "all planes in the deepest layer"),
-        (dict(z=ZS, medium=hr.Medium.half_space(0.15, 4 + 0.4j)), "no loss to compensate"),
-        (dict(z=ZS, combine="none"), "combine='coherent'"),
-        (dict(z=ZS, fov="full"), "fov='aperture'"),
+        (dict(z=zs, medium=hr.Medium.half_space(0.15, 4 + 0.4j)), "no loss to compensate"),
+        (dict(z=zs, combine="none"), "combine='coherent'"),
+        (dict(z=zs, fov="full"), "fov='aperture'"),
     ]
     for kw, why in cases:
         z = kw.pop("z")
@@ -85,17 +87,17 @@ def test_stolt_refuses_what_it_cannot_do_and_auto_falls_back():
             hr.migrate(h, z, algorithm="stolt", **kw)
         hr.migrate(h, z, **kw)   # "auto" does it, by the exact sum
     # A receiver array: without its source, or lit by a point source.
-    bare = _hologram(False, None).replace(source=None)
+    bare = _hologram(False, None, n=12).replace(source=None)
     with pytest.raises(ValueError, match=r"hologram\.source"):
-        hr.migrate(bare, ZS, algorithm="stolt")
-    horn = _hologram(False, None, source=hr.PointSource((0.0, 0.0, -0.3)))
+        hr.migrate(bare, zs, algorithm="stolt")
+    horn = _hologram(False, None, source=hr.PointSource((0.0, 0.0, -0.3)), n=12)
     with pytest.raises(ValueError, match="PointSource"):
-        hr.migrate(horn, ZS, algorithm="stolt")
-    a = hr.migrate(horn, ZS)
-    b = hr.migrate(horn, ZS, algorithm="frequency")
+        hr.migrate(horn, zs, algorithm="stolt")
+    a = hr.migrate(horn, zs)
+    b = hr.migrate(horn, zs, algorithm="frequency")
     np.testing.assert_array_equal(a.data, b.data)
     # The lossy ground is allowed with the loss left uncompensated.
     lossy = hr.Medium.half_space(0.15, 4 + 0.4j)
-    hr.migrate(h, ZS, medium=lossy, algorithm="stolt", compensate_loss=False)
+    hr.migrate(h, zs, medium=lossy, algorithm="stolt", compensate_loss=False)
     with pytest.raises(ValueError, match="several frequencies"):
-        hr.migrate(h.at_frequency(0), ZS, algorithm="stolt")
+        hr.migrate(h.at_frequency(0), zs, algorithm="stolt")
