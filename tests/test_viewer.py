@@ -443,7 +443,9 @@ def test_page_overlays_and_lists_the_objects(scene, tmp_path):
     np.testing.assert_allclose(src["areas"]["ys"][0], [3.0, 3.0, 7.0, 7.0], atol=1e-12)
     assert src["areas"]["n"] == [3] and src["labels"]["text"] == ["1", "2", "3"]
     table = dict(page.obj_table_src.data)
+    assert page.obj_table.visible
     assert table["n"] == [1, 2, 3] and table["kind"] == ["point", "line", "area"]
+    # an interval where the table has one
     assert table["depth"] == ["12.0 [11.0, 13.5]", "10.0", "15.0"]
     assert table["size"] == ["-", "10.0 long", "6.0 x 4.0"]
     assert table["snr"] == ["21.3", "15.0", "12.0"]
@@ -523,7 +525,7 @@ def test_find_objects_runs_detect_on_the_plane_shown(scene, tmp_path, monkeypatc
     S = ViewSession(paths[:1])
     page = ViewerPage(Document(), S, S.default_settings(ground=SAND).replace(depth=0.1, planes=5),
                       tmp_path)
-    assert page.obj_table_src.data["n"] == []
+    assert page.obj_table_src.data["n"] == [] and not page.obj_table.visible  # no room taken
     page.depth.value = 12.0
     page._find()
     (image, medium), = seen

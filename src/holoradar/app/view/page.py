@@ -707,10 +707,12 @@ class ViewerPage:
             self.obj_sections.append(src)
         self.obj_table_src = ColumnDataSource(data=table_rows(None, 0.0),
                                               name="objects_source")
+        widths = {"n": 30, "kind": 50, "depth": 150, "size": 90}
+        # Shown once there are objects (an empty list would only take room).
         self.obj_table = DataTable(
             source=self.obj_table_src, name="objects", height=160, index_position=None,
-            sizing_mode="stretch_width", selectable=True, sortable=False,
-            columns=[TableColumn(field=k, title=t, width=40 if k == "n" else 90)
+            sizing_mode="stretch_width", selectable=True, sortable=False, visible=False,
+            columns=[TableColumn(field=k, title=t, width=widths.get(k, 60))
                      for k, t in TABLE_FIELDS])
         self.obj_table_src.selected.on_change("indices", lambda _a, _o, n: self._goto(n))
 
@@ -728,7 +730,11 @@ class ViewerPage:
                                  section_marks(df, surface, self.section_at, near),
                                  strict=True):
                 src.data = data
-        self.obj_table_src.data = table_rows(df, surface)
+        rows = table_rows(df, surface)
+        self.obj_table_src.data = rows
+        n = len(rows["n"])
+        self.obj_table.visible = n > 0
+        self.obj_table.height = min(160, 30 + 26 * n)
 
     def _near(self) -> float:
         """How far from a section an object is marked on it: half a resolution cell
