@@ -123,3 +123,24 @@ def test_migrate_ground_takes_the_route_it_is_given():
     assert sum(np.array_equal(images["auto"], images[r]) for r in ("direct", "nufft")) == 1
     with pytest.raises(ValueError, match="route must be 'auto', 'nufft' or 'direct'"):
         oblique.migrate_ground(h, zs, sand, route="fast")
+
+
+def test_elements_off_a_uniform_grid_take_the_direct_sums():
+    # finufft needs uniform modes: a hologram whose x' are not evenly spaced is summed
+    # directly by default (exactly: 1e-12 of the largest value, the rounding), and the
+    # nufft route refuses it by name.
+    rng = np.random.default_rng(2)
+    x = np.array([0.0, 0.01, 0.025, 0.03, 0.05, 0.06, 0.08, 0.09])
+    y = (np.arange(6) - 2.5) * 0.012
+    d = rng.standard_normal((6, 8)) + 1j * rng.standard_normal((6, 8))
+    pose = hr.Pose((0.0, 0.0, 0.05), tilt=np.radians(35), azimuth=np.radians(30))
+    h = hr.Hologram(d, x, y, F0, pose=pose)
+    args = ((128, 128), (0.01, 0.01), (-0.6, -0.6, float(h.points[:, 2].max())))
+    # 128^2 x 48 products: evenly spaced, these elements would go to finufft
+    assert choose_route(args[0], pose, d.shape) == "nufft"
+    got = _spectrum_on_plane(h, *args, np.dtype(complex), gap=0.2)
+    ref = _exact(h, *args, h.k)
+    keep = got != 0
+    np.testing.assert_allclose(got[keep], ref[keep], rtol=0, atol=1e-12 * np.abs(ref).max())
+    with pytest.raises(ValueError, match=r"hologram\.x must be uniformly spaced"):
+        _spectrum_on_plane(h, *args, np.dtype(complex), gap=0.2, route="nufft")

@@ -289,7 +289,9 @@ def _spectrum_on_plane(hologram: Hologram, grid: tuple[int, int], pitch: tuple[f
     pose = hologram.pose
     reach = -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12)   # largest Im(kz) kept
     if route == "auto":
-        route = choose_route(grid, pose, hologram.data.shape[-2:])
+        # finufft needs the elements on a uniform grid; the direct sums do not
+        route = choose_route(grid, pose, hologram.data.shape[-2:]) \
+            if _uniform(hologram.x) and _uniform(hologram.y) else "direct"
     if route == "nufft":
         return spectrum_nufft(hologram, grid, pitch, origin, work, reach)
     key = ("ground-basis", grid, pitch, origin, kk, pose, hologram.x.tobytes(),
@@ -358,6 +360,17 @@ def choose_route(grid: tuple[int, int], pose: Any, shape: tuple[int, int]) -> st
     else:
         products = My * Mx * nx * ny
     return "direct" if products <= DIRECT_MAX_PRODUCTS else "nufft"
+
+
+def _uniform(axis: np.ndarray) -> bool:
+    """Whether element coordinates are uniformly spaced (one element: trivially)."""
+    if axis.size < 2:
+        return True
+    try:
+        uniform_step(axis, "axis")
+    except ValueError:
+        return False
+    return True
 
 
 def _dense(values: np.ndarray, index: np.ndarray, grid: tuple[int, int]) -> np.ndarray:

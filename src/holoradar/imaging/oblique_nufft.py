@@ -11,14 +11,15 @@ Per wavenumber ``K.(r_e - r0) = K.(c - r0) + s x'_j + t y'_i`` with ``s = K.u``,
 the points ``(t dy', s dx')``, i.e. a type-2 non-uniform FFT (finufft,
 ``isign = -1``, modes centred on ``(ny // 2, nx // 2)``). ``s``, ``t`` are real
 for the components that travel in the air (``kz`` real), which is where finufft
-applies; its relative error is the requested ``eps`` (1e-6 in complex128, 1e-5
-in complex64).
+applies; it aims at a relative l2 error ``eps`` (:data:`EPS`: 1e-6 in complex128,
+1e-5 in complex64; measured within 2 eps). The elements must lie on a uniform grid.
 
 The components evanescent in the air (``kz = i kappa``) that the air gap keeps
 (``kappa`` below the floor of :mod:`~holoradar.imaging.oblique`) have complex
 ``s``, ``t`` when the aperture is tilted: they are summed directly, on that subset
 only, factored by the aperture's axes (by grid column when ``x'`` lies along the
-world ``x``, by grid row when ``y'`` lies along ``y``, in full otherwise). The
+world ``x``, by grid row when ``y'`` lies along ``y``, then by Horner's rule along
+the other axis; in full, in blocks, otherwise). The
 element offsets are taken from the lowest corner, so every factor has a modulus
 of at most 1 (no overflow however large the aperture's rise). A level aperture
 has real ``s``, ``t`` for every component: finufft takes them all.
