@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 import holoradar as hr
-from holoradar.app.report.table import COLUMNS
+from holoradar.app.report.table import COLUMNS, MISSING
 
 SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
 
@@ -63,7 +63,7 @@ def assert_table_is_detects(rows: list[dict[str, tuple[str, str]]], df: pd.DataF
             value, shown = row[col]
             want = float(rec[col])
             if math.isnan(want):
-                assert value == "nan" and shown == ""
+                assert value == "nan" and shown == MISSING
             else:
                 assert float(value) == want            # repr reads back to the same double
                 assert shown == f"{want * factor:.{digits}f}"
@@ -114,7 +114,7 @@ def test_self_contained(made):
 def test_ground_device_history_shown(made):
     text = made["text"]
     assert "the image&#x27;s history: the ground it was imaged through" in text
-    assert "2.2 to 2.8 (given (eps_interval))" in text
+    assert "2.2 to 2.8, given as eps_interval: widens" in text
     assert "2.5 + 0.0125j" in text and "at range 30.0 cm from the array" in text
     assert "<b>migrate</b>" in text and "<b>save</b>" in text      # the file's history
     img = hr.load(made["img"])

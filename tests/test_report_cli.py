@@ -50,7 +50,7 @@ def test_two_files_one_report_numbered_as_detect(image, tmp_path):
         for n, obj in enumerate(det, 1):
             assert f'<tr id="s{k}-object-{n}">' in text
             assert f'<td data-col="x" data-value="{obj["x"]!r}">' in text
-    assert "given (--eps/--z-surface)" in text and "(given (--eps-interval))" in text
+    assert "given as --eps/--z-surface" in text and "2.2 to 2.8, given as --eps-interval" in text
 
 
 def test_existing_output_kept_without_force(image, tmp_path):

@@ -29,7 +29,7 @@ def _interval(eps_interval: Any, name: str) -> tuple[tuple[float, float] | None,
     if eps_interval is None:
         return None, ""
     how = "the autofocus's interval" if hasattr(eps_interval, "eps_focus") else \
-        f"given ({name})"
+        f"given as {name}"
     try:
         return as_eps_interval(eps_interval), how
     except (TypeError, ValueError) as exc:

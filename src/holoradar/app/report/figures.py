@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -105,31 +106,49 @@ def draw_objects(ax: Any, table: Any, rows: Sequence[int], cell: float, *,
 
 def _plan(x: np.ndarray, y: np.ndarray, amp: np.ndarray, title: str, table: Any,
           rows: Sequence[int], cell: float) -> Figure:
-    """A plan view; a long strip (a survey) is cut into rows stacked one above the other."""
+    """A plan view; a long strip (a survey) is cut into pieces stacked one above the other.
+
+    The axes are placed by hand (inches), not by a layout engine: a survey's dozen
+    panels would otherwise cost seconds of layout.
+    """
     wx, wy = float(np.ptp(x)) or 1e-3, float(np.ptp(y)) or 1e-3
     pieces = max(1, min(12, math.ceil(wx / wy / 5)))
     edges = np.linspace(float(x[0]), float(x[-1]), pieces + 1)
-    width = 9.0
-    panel_h = min(7.0, max(1.6, (width - 1.6) * min(wy / (wx / pieces), 1.0) + 0.9))
-    fig = Figure(figsize=(width, panel_h * pieces + 0.5), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(pieces, 1))
+    ye = _edges(y) * _CM
+    dx = float(x[1] - x[0]) if x.size > 1 else wx
+    span = (wx / pieces + dx) * _CM                  # one piece with its edge pixels, cm
+    left, right, top, gap, bottom = 0.85, 1.45, 0.5, 0.5, 0.55  # inches
+    pw = 6.8
+    ph = pw * float(ye[-1] - ye[0]) / span
+    if ph > 6.4:
+        pw, ph = pw * 6.4 / ph, 6.4
+    width = left + pw + right
+    height = top + pieces * ph + (pieces - 1) * gap + bottom
+    fig = Figure(figsize=(width, height))
     a = _db(amp)
-    for k, ax in enumerate(axes):
+    m = None
+    for k in range(pieces):
+        y0 = bottom + (pieces - 1 - k) * (ph + gap)
+        ax = fig.add_axes((left / width, y0 / height, pw / width, ph / height))
         sel = np.nonzero((x >= edges[k] - 1e-12) & (x <= edges[k + 1] + 1e-12))[0]
         sel = np.arange(max(sel[0] - 1, 0), min(sel[-1] + 2, x.size)) if sel.size else sel
-        m = ax.pcolormesh(_edges(x[sel]) * _CM, _edges(y) * _CM, a[:, sel], cmap="inferno",
-                          vmin=-DB_RANGE, vmax=0.0, shading="flat")
+        xe = _edges(x[sel]) * _CM
+        m = ax.imshow(a[:, sel], extent=(xe[0], xe[-1], ye[0], ye[-1]), origin="lower",
+                      interpolation="nearest", cmap="inferno", vmin=-DB_RANGE, vmax=0.0,
+                      aspect="auto")
         inside = [i for i in rows if x[sel][0] <= table.iloc[i]["x"] <= x[sel][-1]]
         draw_objects(ax, table, inside, cell, span=float(np.ptp(x[sel])) or wx)
-        ax.set_xlim(_edges(x[sel])[0] * _CM, _edges(x[sel])[-1] * _CM)
-        ax.set_ylim(_edges(y)[0] * _CM, _edges(y)[-1] * _CM)
-        ax.set_aspect("equal")
+        ax.set_xlim(xe[0], xe[0] + span)
+        ax.set_ylim(ye[0], ye[-1])
         ax.set_ylabel("y (cm)")
-        if k == len(axes) - 1:
+        if k == pieces - 1:
             ax.set_xlabel("x (cm)")
-    fig.colorbar(m, ax=list(axes), label=f"|E| (dB re the brightest pixel; {DB_RANGE:.0f} "
-                                         "dB shown)", shrink=0.9 if pieces == 1 else 0.6)
-    fig.suptitle(title, fontsize=11)
+    bar_h = min(ph * pieces + gap * (pieces - 1), 4.5)
+    cax = fig.add_axes(((left + pw + 0.25) / width, (height - top - bar_h) / height,
+                        0.18 / width, bar_h / height))
+    fig.colorbar(m, cax=cax, label=f"|E| (dB re the brightest pixel; {DB_RANGE:.0f} dB "
+                                   "shown)")
+    fig.suptitle(title, fontsize=11, y=1 - 0.15 / height, va="top")
     return fig
 
 
@@ -231,7 +250,7 @@ def _survey_pictures(section: Section, cell: float) -> list[Picture]:
     from ...survey.store import read_index
 
     table = section.table
-    planes = np.asarray(read_index(section.store)["z"], dtype=float)
+    planes = np.asarray(read_index(Path(section.store))["z"], dtype=float)
     ranges = np.asarray(table["range"], dtype=float) if len(table) else np.zeros(0)
     amps = np.asarray(table["amplitude_db"], dtype=float) if len(table) else np.zeros(0)
     chosen = _plane_choice(ranges, amps, planes) or [0]

@@ -41,6 +41,7 @@ pre { background: #f6f8fa; padding: 8px; overflow-x: auto; font-size: 12px;
       white-space: pre-wrap; }
 ul.warnings li { color: #9a6700; }
 .none { color: #57606a; font-style: italic; }
+p.note { color: #57606a; font-size: 13px; margin: 2px 0; }
 """
 
 
@@ -88,7 +89,7 @@ def ground_rows(g: Ground) -> list[tuple[str, str]]:
     if g.eps_interval is not None:
         lo, hi = g.eps_interval
         rows.append(("eps' interval", f"{lo:.4g} to {hi:.4g}"
-                     + (f" ({g.interval_how})" if g.interval_how else "")
+                     + (f", {g.interval_how}" if g.interval_how else "")
                      + ": widens the depths' 95 % intervals"))
     else:
         rows.append(("eps' interval", "none given: the depth intervals are the range's "
@@ -123,7 +124,8 @@ def detection_rows(d: dict[str, Any], table: Any) -> list[tuple[str, str]]:
     cell = d.get("resolution_cell")
     if cell:
         rows.append(("resolution cell", " x ".join(_cm(c) for c in cell[:2])
-                     + (f", {_cm(cell[2])} in range" if len(cell) > 2 else "")))
+                     + (f", {_cm(cell[2])} in range" if len(cell) > 2 and cell[2] is not None
+                        else ", none in range (one frequency)" if len(cell) > 2 else "")))
     if d.get("frames") is not None:
         rows.append(("frames searched", str(d["frames"])))
     return rows
@@ -159,7 +161,17 @@ def _figure(p: Picture) -> str:
     data = base64.b64encode(p.png).decode("ascii")
     return (f'<figure class="{p.kind}"><img alt="{_e(p.caption)}" width="{p.width}" '
             f'height="{p.height}" src="data:image/png;base64,{data}">'
-            f"<figcaption>{_e(p.caption)}</figcaption></figure>")
+            f"<figcaption>{_e(p.caption)}. {_LEGEND[p.kind]}</figcaption></figure>")
+
+
+_LEGEND = {
+    "plan": "|E| in dB re the brightest pixel. Objects outlined and numbered as in the "
+            "table: a point as a circle one resolution cell across, a line from end to end, "
+            "an area by its outline; each object on the plane nearest its range.",
+    "section": "|E| in dB re the section's brightest pixel; the objects within one "
+               "resolution cell of the section (and the lines crossing it) circled at their "
+               "range and numbered as in the table.",
+}
 
 
 def section_html(k: int, s: Section, pics: Sequence[Picture]) -> str:

@@ -152,7 +152,11 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
     ground = _ground(req, obj, path)
     args = {"false_alarm": req.false_alarm, "kinds": req.kinds,
             "eps_interval": req.eps_interval}
+    extra: list[tuple[str, str]] = []
     if isinstance(obj, Image):
+        if hologram is not None:
+            hologram, hattrs = _read_hologram(hologram, req)
+            extra = [(f"hologram: {k}", v) for k, v in device_rows(hologram, hattrs)]
         draw, table = _image_objects(obj, name, ground.medium, args, req, hologram, detections)
         kind = "image"
     else:
@@ -161,15 +165,30 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
         draw, table = _hologram_objects(obj, name, ground.medium, args, req, detections)
         kind = "hologram"
     return Section(name=name, kind=kind, image=draw, table=table, ground=ground,
-                   detection=_detection(table, req), device=device_rows(obj, attrs),
+                   detection=_detection(table, req), device=device_rows(obj, attrs) + extra,
                    history=history_of(attrs))
+
+
+def _read_hologram(hologram: Any, req: Request) -> tuple[Any, dict[str, Any]]:
+    """The hologram an image was imaged from, and its file's attributes."""
+    from ...data.hologram import Hologram
+
+    if isinstance(hologram, Hologram):
+        return hologram, {}
+    from ..cli.common import read_hologram
+
+    try:
+        holo = read_hologram(Path(hologram), req.layout, req.check)
+    except ValueError as exc:
+        raise ValueError(f"{req.names['hologram']}: {exc}") from None
+    return holo, file_attributes(hologram)
 
 
 def _ground(req: Request, obj: Any, path: Path | None) -> Ground:
     from ...data.hologram import Image
 
     n = req.names
-    medium, how = req.medium, f"given ({n['medium']})"
+    medium, how = req.medium, f"given as {n['medium']}"
     if medium is None and isinstance(obj, Image) and path is not None:
         from ..cli.detect import _history_medium
 
@@ -199,7 +218,6 @@ def _one_plane(z: Any, planes: np.ndarray, req: Request, name: str) -> float:
 
 def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: Request,
                    hologram: Any, detections: Any) -> tuple[Any, Any]:
-    from ...data.hologram import Hologram
     from ..cli.detect import _detect, _fit, _level, _options_of
 
     n = req.names
@@ -211,15 +229,7 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
                              "plane, from the image alone), not both")
         if detections is not None:
             return img, detections
-        if isinstance(hologram, Hologram):
-            holo = hologram
-        else:
-            from ..cli.common import read_hologram
-
-            try:
-                holo = read_hologram(Path(hologram), req.layout, req.check)
-            except ValueError as exc:
-                raise ValueError(f"{n['hologram']}: {exc}") from None
+        holo = hologram
         fit_medium = medium
         if holo.pose.is_level:
             holo, fit_medium = _level(holo, medium)

@@ -14,7 +14,10 @@ import html
 import math
 from typing import Any
 
-__all__ = ["COLUMNS", "objects_table"]
+__all__ = ["COLUMNS", "MISSING", "objects_table"]
+
+MISSING = "–"
+"""What a cell shows for a value ``hr.detect`` leaves out (NaN): an en dash."""
 
 COLUMNS: list[tuple[str, str, float, int]] = [
     ("x", "x (cm)", 100.0, 1),
@@ -42,7 +45,7 @@ def _number(v: Any) -> float:
 
 def _cell(col: str, value: Any, factor: float, digits: int) -> str:
     v = _number(value)
-    shown = "" if not math.isfinite(v) else f"{v * factor:.{digits}f}"
+    shown = MISSING if not math.isfinite(v) else f"{v * factor:.{digits}f}"
     return f'<td data-col="{col}" data-value="{html.escape(repr(v))}">{shown}</td>'
 
 
@@ -74,4 +77,23 @@ def objects_table(table: Any, source: str, key: str = "s1") -> str:
                     f"{cells}{extra}</tr>")
     return (f'<table class="objects" data-source="{html.escape(source)}"><thead><tr>'
             f'<th>#</th><th>kind</th>{head}{"<th>frame</th>" if frame else ""}</tr></thead>'
-            f'<tbody>{"".join(rows)}</tbody></table>')
+            f'<tbody>{"".join(rows)}</tbody></table>{_notes(table)}')
+
+
+def _notes(table: Any) -> str:
+    """What the blanks mean, where there are any."""
+    notes = []
+    if {"depth", "depth_low"} <= set(table.columns):
+        plane = [i + 1 for i, (d, lo) in enumerate(zip(table["depth"], table["depth_low"],
+                                                      strict=True))
+                 if math.isfinite(_number(d)) and not math.isfinite(_number(lo))]
+        if plane:
+            notes.append(f"Object(s) {', '.join(map(str, plane))}: found on one plane from "
+                         "the image alone, so the depth is the plane's and has no interval "
+                         "(give the hologram for a fitted range with its 95 % interval).")
+    if "depth" in table.columns and not any(math.isfinite(_number(d)) for d in table["depth"]):
+        notes.append("No depths: no ground with a surface was given or found; ranges are "
+                     "from the array.")
+    notes.append(f"{MISSING}: not defined for this kind of object (an azimuth or area for a "
+                 "point) or not measured.")
+    return "".join(f'<p class="note">{html.escape(n)}</p>' for n in notes)
