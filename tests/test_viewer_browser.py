@@ -407,9 +407,12 @@ def _wait_objects(driver, timeout: float = 300.0) -> str:
     raise TimeoutError("the page did not finish finding the objects")
 
 
+@pytest.mark.slow
 def test_objects_of_a_file_are_overlaid_and_listed(rod, browser, tmp_path):
     # A table as `holoradar detect -o objects.csv` writes it (three objects about the rod,
-    # one of each kind): the page lists three rows and its glyphs carry them.
+    # one of each kind): the page lists three rows and its glyphs carry them. (Slow: a
+    # server of its own, 12-20 s; the glyphs' and the list's data are tested without a
+    # browser in test_viewer.py.)
     import pandas as pd
 
     from holoradar.analysis.detect.table import COLUMNS
