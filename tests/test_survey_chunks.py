@@ -9,7 +9,9 @@ lie in their chunks (whole chunks, partial ones, a skipped frame between two).
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -117,6 +119,35 @@ def test_an_error_between_chunks_leaves_done_marks_matching_the_data(
     monkeypatch.setattr(survey_worker, "migrate", real)
     s = hr.survey.run_batch(paths, store, z=Z, workers=1)
     assert (s["resumed"], s["done"]) == (6, 6) and _consistent(store, paths, holos).all()
+
+
+def test_a_failure_inside_a_chunk_write_leaves_no_frame_marked_done_without_its_data(
+        survey, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The real write order: a failure after a chunk's images and positions are written
+    but before its done flags (here: the clock read for ``finished`` fails on the second
+    chunk) leaves that chunk's frames not done; a rerun images them."""
+    paths, holos = survey
+    monkeypatch.setattr(survey_batch, "frames_per_chunk", lambda per, n: 4)
+    calls = [0]
+
+    def clock() -> float:
+        calls[0] += 1
+        if calls[0] == 2:
+            raise OSError("disk gone (simulated)")
+        return 1.7e9
+
+    monkeypatch.setattr(survey_store, "time", SimpleNamespace(
+        time=clock, strftime=time.strftime, gmtime=time.gmtime))
+    store = tmp_path / "s.zarr"
+    with pytest.raises(OSError, match="simulated"):
+        hr.survey.run_batch(paths, store, z=Z, workers=1)
+    done = _consistent(store, paths, holos)
+    assert not done[4:8].any() and done[:4].all()
+    idx = survey_store.read_index(store)
+    assert not np.isnan(survey_store.read_images(idx, range(4, 8))).any()  # images written
+    monkeypatch.undo()
+    s = hr.survey.run_batch(paths, store, z=Z, workers=1)
+    assert s["resumed"] + s["done"] == 12 and _consistent(store, paths, holos).all()
 
 
 def test_a_damaged_frame_is_remembered_and_not_parsed_again(

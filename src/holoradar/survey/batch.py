@@ -401,10 +401,8 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
               drain=sched in ("threads", "processes"))
     records: list[dict[str, Any]] = []
     used = {"scheduler": sched, "workers": 1}
-    try:
-        if todo:
-            _execute(todo, chunk, job, sched, client, workers, progress, records, used)
-    finally:
+
+    def remember() -> None:
         # Why frames are missing, kept in the store for `holoradar info` and the next run
         # (by absolute path), also when the run stops early.
         by_name = {name: str(k) for k, name in frames_in}
@@ -415,6 +413,19 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
         reasons.update(read_bad)
         note_skipped(target, reasons, [str(p) for p in seen],
                      {k: v for k, v in stamps.items() if k in read_bad and v is not None})
+
+    try:
+        if todo:
+            _execute(todo, chunk, job, sched, client, workers, progress, records, used)
+    except BaseException:
+        try:
+            remember()
+        except Exception:  # the run's own exception is the one to see
+            pass
+        raise
+    else:
+        remember()
+    finally:
         stop_file.unlink(missing_ok=True)
     skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
                 if r["status"] == "skipped"]
