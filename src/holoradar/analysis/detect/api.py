@@ -108,11 +108,12 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
     >>> len(df), round(float(df.x[0]), 2), round(float(df.range[0]), 2)
     (1, 0.02, 0.5)
     """
-    import pandas as pd
-
     fa, ks = _check(false_alarm, kinds, medium, eps_interval)
     interval = as_eps_interval(eps_interval)
     vol = as_volume(image)
+    if isinstance(max_objects, bool) or not isinstance(max_objects, int | np.integer) \
+            or max_objects < 1:
+        raise ValueError(f"max_objects must be a whole number >= 1, got {max_objects!r}")
     if hologram is not None:
         from .model import HologramModel
 
@@ -121,18 +122,45 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         if migrate_options:
             raise ValueError("migrate_options needs hologram=")
         if vol.z.size > 1:
-            raise ValueError("image: a volume (several ranges) needs hologram= (a point's "
-                             "response along range comes from the hologram); without it pass "
-                             "one plane, e.g. image.plane(z)")
-        from .psf import ApertureModel
-        from .window import WindowModel
+            if not _wideband(vol):
+                raise ValueError("image: a volume at one frequency needs hologram= (its "
+                                 "range focus is tens of centimetres long: a point's "
+                                 "response along range comes from the hologram); without "
+                                 "it pass one plane, e.g. image.plane(z)")
+            from .stack import detect_planes
 
-        model = ApertureModel(vol, medium) if ApertureModel.applies(vol) else \
-            WindowModel(vol, medium)
-    if isinstance(max_objects, bool) or not isinstance(max_objects, int | np.integer) \
-            or max_objects < 1:
-        raise ValueError(f"max_objects must be a whole number >= 1, got {max_objects!r}")
-    result = clean(vol, model, fa, max_objects=int(max_objects))
+            def run_plane(plane: Volume, rate: float
+                          ) -> tuple[list[dict[str, Any]], CleanResult, str]:
+                model = _image_model(plane, medium)
+                return (*_one(plane, model, medium, rate, ks, int(max_objects), interval),
+                        model.kind)
+
+            rows, meta = detect_planes(vol, run_plane, fa, medium, interval)
+            return _frame(rows, meta, fa)
+        model = _image_model(vol, medium)
+    rows, result = _one(vol, model, medium, fa, ks, int(max_objects), interval)
+    return _frame(rows, {"threshold": float(result.noise.t),
+                         "resolution_cell": [float(c) for c in result.noise.cell],
+                         "n_cells": float(result.noise.n_cells), "model": model.kind}, fa)
+
+
+def _wideband(vol: Volume) -> bool:
+    return vol.frequency is not None and np.atleast_1d(vol.frequency).size > 1
+
+
+def _image_model(vol: Volume, medium: Any) -> Any:
+    """The image's own point response (one frequency, a level array's grid) or the
+    analytic spectral window."""
+    from .psf import ApertureModel
+    from .window import WindowModel
+
+    return ApertureModel(vol, medium) if ApertureModel.applies(vol) else WindowModel(vol, medium)
+
+
+def _one(vol: Volume, model: Any, medium: Any, fa: float, ks: set[str], max_objects: int,
+         interval: tuple[float, float] | None) -> tuple[list[dict[str, Any]], CleanResult]:
+    """CLEAN one image with one model, the components grouped into areas and lines."""
+    result = clean(vol, model, fa, max_objects=max_objects)
     rows = _rows(result, vol, model, medium, interval)
     if "area" in ks:
         from .areas import group_areas
@@ -144,11 +172,15 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         rows = group_lines(rows, result.noise.cell, model)
     if "point" not in ks:
         rows = [r for r in rows if r["kind"] != "point"]
+    return rows, result
+
+
+def _frame(rows: list[dict[str, Any]], meta: dict[str, Any], fa: float) -> Any:
+    import pandas as pd
+
     df = pd.DataFrame(rows, columns=COLUMNS)
-    df.attrs.update({"threshold": float(result.noise.t), "false_alarm": fa,
-                     "resolution_cell": [float(c) for c in result.noise.cell],
-                     "n_cells": float(result.noise.n_cells),
-                     "model": model.kind,
+    df.attrs.update(meta)
+    df.attrs.update({"false_alarm": fa,
                      "outlines": {i: r["outline"] for i, r in enumerate(rows) if "outline" in r}})
     return df
 
