@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.analysis.detect import detect
+from holoradar.analysis.detect import detect, rebar_layers
 from holoradar.analysis.detect.grid import Volume
 from holoradar.analysis.detect.stack import _merge, _place, range_cell
 
@@ -52,6 +52,12 @@ def _check_mat(df, cell: float) -> None:
     cz = range_cell(BAND, 6.0)
     assert along_x.depth.to_numpy() == pytest.approx(0.04, abs=cz / 4)
     assert along_y.depth.to_numpy() == pytest.approx(0.06, abs=cz / 4)
+    # The mat per direction: two layers of two bars, 15 cm apart, 4 and 6 cm cover.
+    layers = rebar_layers(df).sort_values("cover")
+    assert layers.bars.tolist() == [2, 2]
+    assert layers.spacing.to_numpy() == pytest.approx(0.15, rel=0.05)
+    assert (layers.cover_low.to_numpy() <= [0.04, 0.06]).all()
+    assert (layers.cover_high.to_numpy() >= [0.04, 0.06]).all()
 
 
 @pytest.mark.slow
@@ -150,3 +156,19 @@ def test_one_frequency_volume_still_needs_the_hologram():
     img = hr.migrate(h, np.array([0.40, 0.45, 0.50]), upsample=2)
     with pytest.raises(ValueError, match="one frequency needs hologram="):
         detect(img)
+
+
+def test_rebar_layers_groups_directions_across_0_and_180_degrees():
+    import pandas as pd
+
+    rows = [{"kind": "line", "x": 0.0, "y": y, "azimuth_deg": az, "depth": 0.05}
+            for y, az in ((-0.1, 179.0), (0.0, 1.0), (0.12, 0.5))]
+    rows.append({"kind": "point", "x": 0.3, "y": 0.3, "azimuth_deg": np.nan, "depth": 0.1})
+    t = rebar_layers(pd.DataFrame(rows))
+    assert t.bars.tolist() == [3]
+    assert t.azimuth_deg[0] == pytest.approx(0.1667, abs=1e-3)
+    assert (t.spacing_min[0], t.spacing_max[0]) == pytest.approx((0.1, 0.12), abs=2e-3)
+    with pytest.raises(ValueError, match="angle_tol_deg"):
+        rebar_layers(pd.DataFrame(rows), angle_tol_deg=95)
+    with pytest.raises(ValueError, match="objects must be"):
+        rebar_layers([1, 2])

@@ -3,10 +3,13 @@
 :func:`detect` finds objects by CLEAN (:mod:`.clean`) above a threshold set by the
 image's own noise (:mod:`.noise`), fits each with its point response (:mod:`.model`
 from the hologram, :mod:`.window` from the image alone), joins elongated ones into
-lines (:mod:`.lines`) and returns a table (:mod:`.table`). See docs/detect.md.
+lines (:mod:`.lines`) and returns a table (:mod:`.table`); a wideband volume without
+its hologram is searched plane by plane (:mod:`.stack`), and :func:`rebar_layers`
+sums a rebar mat's lines up per direction. See docs/detect.md.
 """
 
 from .api import detect
+from .rebar import rebar_layers
 from .table import COLUMNS
 
-__all__ = ["COLUMNS", "detect"]
+__all__ = ["COLUMNS", "detect", "rebar_layers"]
