@@ -68,7 +68,6 @@ def _kernel() -> Any:
     """The compiled column sum (numba, cached on disk; built on first use)."""
     import numba
 
-    @numba.njit(cache=True, fastmath=False, nogil=True, error_model="numpy")
     def column_sum(ar, ai, sr, si, jm, bend, pos, order, n, j0, j1, zero, outv):
         # Block-major (nblocks, nf, L): ar, ai each term's value at plane j0 (updated in
         # place to j1); sr, si its step; jm its last plane; bend (nblocks,) the last
@@ -145,7 +144,11 @@ def _kernel() -> Any:
                         o[2 * p[c] + 1] = acc[2 * q + 1, c]
                 j += k
 
-    return column_sum
+    options = dict(fastmath=False, nogil=True, error_model="numpy")
+    try:
+        return numba.njit(cache=True, **options)(column_sum)
+    except RuntimeError:   # no writable cache folder (read-only install, no NUMBA_CACHE_DIR)
+        return numba.njit(cache=False, **options)(column_sum)
 
 
 def warm() -> None:
