@@ -13,9 +13,15 @@ import pandas as pd
 import pytest
 
 import holoradar as hr
-from holoradar.app.report.table import COLUMNS, MISSING
+from holoradar.app.report.table import MISSING
 
 SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+# What the table shows of hr.detect's columns (metres, m^2, degrees, dB): the factor to
+# the unit shown (cm, cm^2, degrees, dB) and the digits shown.
+SHOWN = {"x": (100.0, 1), "y": (100.0, 1), "range": (100.0, 1), "depth": (100.0, 1),
+         "depth_low": (100.0, 1), "depth_high": (100.0, 1), "length": (100.0, 1),
+         "width": (100.0, 1), "azimuth_deg": (1.0, 0), "area": (1e4, 0),
+         "amplitude_db": (1.0, 1), "snr_db": (1.0, 1)}
 
 
 class _Page(html.parser.HTMLParser):
@@ -59,7 +65,7 @@ def assert_table_is_detects(rows: list[dict[str, tuple[str, str]]], df: pd.DataF
     assert len(rows) == len(df)
     for n, (row, rec) in enumerate(zip(rows, df.to_dict("records"), strict=True), 1):
         assert row["number"][1] == str(n) and row["kind"][1] == rec["kind"]
-        for col, _, factor, digits in COLUMNS:
+        for col, (factor, digits) in SHOWN.items():
             value, shown = row[col]
             want = float(rec[col])
             if math.isnan(want):
@@ -95,6 +101,9 @@ def test_table_is_detects(made):
     assert len(page.tables) == 1
     assert len(made["ref"]) >= 2       # the two points (and what else detect finds)
     assert_table_is_detects(page.tables[0], made["ref"])
+    for head in ("x (cm)", "depth 95 % low (cm)", "azimuth (deg)", "area (cm²)",
+                 "amplitude (dB)", "SNR (dB)"):
+        assert f"<th>{head}</th>" in made["text"]
     assert made["summary"]["n_objects"] == len(made["ref"])
 
 
@@ -186,3 +195,39 @@ def test_bad_sources_and_outputs_refused(made, tmp_path):
     with pytest.raises(ValueError, match="one of the inputs"):
         hr.report(same, same, force=True)
     assert same.read_text() == "data"
+
+
+@pytest.mark.slow
+def test_survey_report_is_detects_in_survey_coordinates(tmp_path):
+    # Two overlapping frames (16 x 16 at 1.25 cm, 10 cm apart) over one point 12 cm deep
+    # at world (0.04, 0.11): the report's table is holoradar detect's for the store (one
+    # stored plane from the images alone), in survey coordinates, the object once; the
+    # plan view is the survey's mosaic.
+    from cli_helpers import run
+
+    scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.04, 0.11, 0.42))])
+    paths = []
+    for i, x0 in enumerate((0.0, 0.1)):
+        ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((x0, 0.1, 0.0)))
+        h = hr.simulate(scene, ap, 9.9e9, include_surface=False, snr_db=40, seed=i)
+        paths.append(hr.save(h, tmp_path / f"frame{i}.nc"))
+    store = tmp_path / "s.zarr"
+    hr.survey.run_batch(paths, store, z=[0.42], medium=SAND, upsample=4,
+                        scheduler="synchronous")
+    out = tmp_path / "survey.html"
+    s = hr.report(store, out, z=0.42)
+    import json
+
+    det = pd.DataFrame(json.loads(run("detect", store, "--z", "0.42", "--json").stdout)
+                       ["objects"]).fillna(np.nan)
+    page = _Page(out.read_text())
+    assert s["sources"][0]["kind"] == "survey"
+    assert_table_is_detects(page.tables[0], det)
+    rows = page.tables[0]
+    assert [r["frame"][1] for r in rows] == list(det["frame"])
+    cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, SAND.apparent_distance(0.42), 0.2)
+    # the point, once, where it lies in the world (within a quarter cell: detect's own
+    # survey test's bound, the window fit's bias well inside it)
+    near = det[np.hypot(det.x - 0.04, det.y - 0.11) < cell / 4]
+    assert len(near) == 1
+    assert "mosaic at 42.0 cm from the arrays (survey coordinates)" in out.read_text()

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.app.report.table import COLUMNS, MISSING
+from holoradar.app.report.table import MISSING
 from holoradar.app.view.browser import find_chromium, headless_chromium
 
 _, _, WHY = find_chromium()
@@ -27,6 +27,12 @@ pytestmark = [pytest.mark.browser,
               pytest.mark.skipif(bool(WHY), reason=f"no browser for the report tests: {WHY}")]
 
 SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+# What the table shows of hr.detect's columns (metres, m^2, degrees, dB): the factor to
+# the unit shown (cm, cm^2, degrees, dB) and the digits shown.
+SHOWN = {"x": (100.0, 1), "y": (100.0, 1), "range": (100.0, 1), "depth": (100.0, 1),
+         "depth_low": (100.0, 1), "depth_high": (100.0, 1), "length": (100.0, 1),
+         "width": (100.0, 1), "azimuth_deg": (1.0, 0), "area": (1e4, 0),
+         "amplitude_db": (1.0, 1), "snr_db": (1.0, 1)}
 
 _ROWS_JS = """
 return [...document.querySelectorAll('table.objects')].map(t =>
@@ -69,7 +75,7 @@ def _same_table(rows: list[dict], df) -> None:
     assert len(rows) == len(df)
     for n, (row, rec) in enumerate(zip(rows, df.to_dict("records"), strict=True), 1):
         assert row["number"][1] == str(n) and row["kind"][1] == rec["kind"]
-        for col, _, factor, digits in COLUMNS:
+        for col, (factor, digits) in SHOWN.items():
             value, shown = row[col]
             want = float(rec[col])
             if math.isnan(want):
