@@ -192,3 +192,31 @@ def test_gauss_newton_finish_is_the_matched_filters_maximum(small):
                                                                 for i in range(3)]),
                             "xatol": 1e-3 * float(std.min()), "fatol": 0, "maxiter": 2000})
     assert np.all(np.abs(res.x - r) <= 0.1 * std + 1e-3 * std)
+
+
+def test_objects_image_by_the_frequencies_sum_equals_migrate(small):
+    h, img, sand = small
+    model = HologramModel(h, as_volume(img), sand, {})
+    model.start()
+    assert model._sum is not None and len(model._sum.groups) == 2   # two FFT grids here
+    g = model.response(np.array([0.0, 0.01, 0.18]))
+    fast = model.image(g)
+    model._sum = None
+    slow = model.image(g)                           # migrate
+    # The same linear operations in another order (sum before the inverse FFT): rounding.
+    assert np.allclose(fast, slow, rtol=0, atol=1e-12 * np.abs(slow).max())
+
+
+def test_frequencies_sum_refused_where_it_does_not_apply(small):
+    from holoradar.analysis.detect.kimage import SpectralSum
+
+    h, img, sand = small
+    model = HologramModel(h, as_volume(img), sand, {})
+    with pytest.raises(ValueError, match="monostatic band"):
+        SpectralSum(h, img.z, sand, {**model.options, "method": "fresnel"})
+    with pytest.raises(ValueError, match="monostatic band"):
+        SpectralSum(h.at_frequency(0), img.z, sand, model.options)
+    plane = hr.migrate(h, float(img.z[5]), medium=sand, upsample=2)
+    single = HologramModel(h, as_volume(plane), sand, {})
+    single.start()
+    assert single._sum is None                      # a plane: migrate itself
