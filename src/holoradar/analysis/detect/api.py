@@ -162,6 +162,9 @@ def _one(vol: Volume, model: Any, medium: Any, fa: float, ks: set[str], max_obje
     """CLEAN one image with one model, the components grouped into areas and lines."""
     result = clean(vol, model, fa, max_objects=max_objects)
     rows = _rows(result, vol, model, medium, interval)
+    from .ringing import absorb_ringing
+
+    rows = absorb_ringing(rows, result.noise.cell, model)
     if "area" in ks:
         from .areas import group_areas
 
