@@ -72,18 +72,23 @@ def _plane_choice(ranges: np.ndarray, amps: np.ndarray, planes: np.ndarray) -> l
     return sorted(chosen)
 
 
-def _label(ax: Any, x: float, y: float, n: int, dx: float) -> None:
-    ax.annotate(str(n), (x * _CM, y * _CM), xytext=(x * _CM + dx, y * _CM + dx),
-                color="white", fontsize=11, fontweight="bold", ha="left", va="bottom",
-                path_effects=_HALO, zorder=5)
+def _label(ax: Any, x: float, y: float, n: int, dx: float, *, left: bool = False) -> None:
+    """The number beside an object: up and to the right, or to the left near the right
+    edge of the view (``left``), clipped to the axes."""
+    sx = -dx if left else dx
+    ax.annotate(str(n), (x * _CM, y * _CM), xytext=(x * _CM + sx, y * _CM + dx),
+                color="white", fontsize=11, fontweight="bold",
+                ha="right" if left else "left", va="bottom", path_effects=_HALO, zorder=5,
+                annotation_clip=True, clip_on=True)
 
 
 def draw_objects(ax: Any, table: Any, rows: Sequence[int], cell: float, *,
-                 span: float) -> None:
+                 span: float, right: float = math.inf) -> None:
     """Outline and number the rows ``rows`` of ``table`` on a plan view in cm.
 
     ``cell`` is the lateral resolution cell (m; a point's circle), ``span`` the
-    view's width (m; sets the labels' offset).
+    view's width (m; sets the labels' offset), ``right`` its right edge (m): an
+    object's number goes to its left within a tenth of the view from it.
     """
     outlines = table.attrs.get("outlines") or {}
     radius = (cell / 2 if cell > 0 else span / 60) * _CM
@@ -101,7 +106,8 @@ def draw_objects(ax: Any, table: Any, rows: Sequence[int], cell: float, *,
         else:
             ax.add_patch(Circle((r["x"] * _CM, r["y"] * _CM), radius, fill=False, ec=_COLOUR,
                                 lw=1.8, zorder=4))
-        _label(ax, float(r["x"]), float(r["y"]), i + 1, dx)
+        _label(ax, float(r["x"]), float(r["y"]), i + 1, dx,
+               left=float(r["x"]) > right - span / 10)
 
 
 def _plan(x: np.ndarray, y: np.ndarray, amp: np.ndarray, title: str, table: Any,
@@ -127,6 +133,9 @@ def _plan(x: np.ndarray, y: np.ndarray, amp: np.ndarray, title: str, table: Any,
     fig = Figure(figsize=(width, height))
     a = _db(amp)
     m = None
+    # each object in exactly one piece: the one its x falls in
+    piece = {i: min(max(int((float(table.iloc[i]["x"]) - edges[0]) / (wx / pieces)), 0),
+                    pieces - 1) for i in rows}
     for k in range(pieces):
         y0 = bottom + (pieces - 1 - k) * (ph + gap)
         ax = fig.add_axes((left / width, y0 / height, pw / width, ph / height))
@@ -136,8 +145,8 @@ def _plan(x: np.ndarray, y: np.ndarray, amp: np.ndarray, title: str, table: Any,
         m = ax.imshow(a[:, sel], extent=(xe[0], xe[-1], ye[0], ye[-1]), origin="lower",
                       interpolation="nearest", cmap="inferno", vmin=-DB_RANGE, vmax=0.0,
                       aspect="auto")
-        inside = [i for i in rows if x[sel][0] <= table.iloc[i]["x"] <= x[sel][-1]]
-        draw_objects(ax, table, inside, cell, span=float(np.ptp(x[sel])) or wx)
+        inside = [i for i in rows if piece[i] == k]
+        draw_objects(ax, table, inside, cell, span=span / _CM, right=(xe[0] + span) / _CM)
         ax.set_xlim(xe[0], xe[0] + span)
         ax.set_ylim(ye[0], ye[-1])
         ax.set_ylabel("y (cm)")
