@@ -18,11 +18,12 @@ GROUND = ["--eps", "2.5+0.0125j", "--z-surface", "0.3"]
 @pytest.fixture(scope="module")
 def image(tmp_path_factory):
     """One point 12 cm deep in sand under a 16 x 16 array at 1.25 cm, imaged on its plane
-    (no history: the ground comes from the flags)."""
+    (no history: the ground comes from the flags); its hologram beside it, holo.nc."""
     d = tmp_path_factory.mktemp("report_cli")
     scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((0.01, -0.01, 0.42))])
     h = hr.simulate(scene, hr.Aperture.grid(16, 0.0125), 9.9e9, include_surface=False,
                     snr_db=40, seed=2)
+    hr.save(h, d / "holo.nc")
     return hr.save(hr.migrate(h, 0.42, medium=SAND, upsample=4), d / "img.nc")
 
 
@@ -97,4 +98,13 @@ def test_output_suffix_and_eps_interval_without_ground(image, tmp_path):
     one_line_error(run("report", image, "-o", tmp_path / "r.pdf", ok=False), "--out", ".html")
     one_line_error(run("report", image, "--eps-interval", "2,3", "-o", tmp_path / "r.html",
                        ok=False), "--eps-interval", "ground")
+    assert _html_files(tmp_path) == []
+
+
+def test_hologram_planes_checked_against_the_array(image, tmp_path):
+    # A hologram FILE is imaged on --z: centimetres typed for metres are refused as
+    # holoradar image and detect refuse them, with the metres meant.
+    res = run("report", image.parent / "holo.nc", "--z", "42", *GROUND, "-o",
+              tmp_path / "r.html", ok=False)
+    one_line_error(res, "--z", "centimetres given for metres", "--z 0.42")
     assert _html_files(tmp_path) == []

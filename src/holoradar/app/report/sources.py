@@ -260,6 +260,17 @@ def _hologram_objects(holo: Any, name: str, medium: Any, args: dict[str, Any], r
     zs = np.atleast_1d(np.asarray(req.z, dtype=float))
     if zs.ndim != 1 or not np.all(np.isfinite(zs)) or np.any(zs < 0):
         raise ValueError(f"{n['z']}: expected ranges in metres (>= 0), got {req.z!r}")
+    if req.check:
+        # holoradar detect's checks of ranges against the array (a unit slip is refused)
+        import click
+
+        from ..cli.common import check_planes
+
+        try:
+            check_planes(holo, zs, ",".join(f"{v:g}" for v in zs), medium, {}, True,
+                         name=n["z"])
+        except click.BadParameter as exc:
+            raise ValueError(f"{exc.param_hint or n['z']}: {exc.message}") from None
     img = migrate(holo, zs, medium=medium, upsample=4)
     if detections is not None:
         return img, detections
@@ -312,7 +323,7 @@ def _store_section(path: Path, name: str, req: Request, hologram: Any,
                 "eps_interval": req.eps_interval}, _Silent())
         except click.BadParameter as exc:
             hint = n["z"] if exc.param_hint == "--z" else str(exc.param_hint or n["sources"])
-            raise ValueError(f"{hint}: {exc.format_message()}") from None
+            raise ValueError(f"{hint}: {exc.message}") from None
     detection = _detection(table, req)
     if info:
         detection.update({"frames": info.get("frames"), "model": info.get("model"),
