@@ -318,10 +318,20 @@ def _handles(store: str, token: str) -> dict[str, Any]:
     h = _HANDLES.get(key)
     if h is None:
         g = zarr.open_group(store, mode="r+")
-        h = {name: g[name] for name in ("image", *_PER_FRAME)}
+        # A frame's image is never all NaN (the fill value): written without Zarr's scan
+        # for empty chunks (a millisecond or more for a chunk of a few MB).
+        h = {name: _always_write(g[name]) for name in ("image", *_PER_FRAME)}
         _HANDLES.clear()  # one run at a time per process: drop the last run's handles
         _HANDLES[key] = h
     return h
+
+
+def _always_write(arr: Any) -> Any:
+    """``arr`` with Zarr's ``write_empty_chunks`` (its API since Zarr 3.1; as it is before)."""
+    try:
+        return arr.with_config({"write_empty_chunks": True})
+    except (AttributeError, TypeError, ValueError):
+        return arr
 
 
 def write_frame(store: str, token: str, slot: int, data: np.ndarray,
