@@ -20,7 +20,8 @@ times stretch, the CPU times much less.
 
 Run: ``.venv/bin/python benchmarks/bench_detect.py [--repeat N] [--out FILE]``
 (default: results_detect.json beside this file). ``--label`` names the code
-measured (e.g. a baseline checkout run with ``PYTHONPATH=<checkout>/src``).
+measured (e.g. a baseline checkout run with ``PYTHONPATH=<checkout>/src``);
+``--baseline FILE`` embeds such a run's JSON and the speed-ups over it.
 """
 
 from __future__ import annotations
@@ -107,6 +108,9 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=REPEAT)
     ap.add_argument("--label", default="current")
     ap.add_argument("--out", type=Path, default=Path(__file__).with_name("results_detect.json"))
+    ap.add_argument("--baseline", type=Path, default=None,
+                    help="a JSON this script wrote for other code (e.g. the checkout before "
+                         "a change): kept under 'baseline', with the speed-ups")
     args = ap.parse_args()
     warnings.filterwarnings("ignore", category=hr.AliasingWarning)
     try:
@@ -121,6 +125,13 @@ def main() -> None:
                        "loadavg_before": load_before, "loadavg_after": os.getloadavg()},
            "env": {k: os.environ.get(k) for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")},
            "repeat": args.repeat, "results": results}
+    if args.baseline is not None:
+        base = json.loads(args.baseline.read_text())
+        out["baseline"] = base
+        out["speedup"] = {
+            r["case"]: {k: b["median"][k] / r["median"][k] for k in ("detect_wall", "detect_cpu")}
+            | {"ratio_cpu_before": b["ratio_cpu"], "ratio_cpu_after": r["ratio_cpu"]}
+            for r in results for b in base["results"] if b["case"] == r["case"]}
     for r in results:
         m = r["median"]
         print(f"{r['case']:7s} {r['shape']}: detect {m['detect_wall']:.2f} s wall "
