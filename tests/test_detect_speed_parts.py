@@ -216,6 +216,15 @@ def test_frequencies_sum_refused_where_it_does_not_apply(small):
         SpectralSum(h, img.z, sand, {**model.options, "method": "fresnel"})
     with pytest.raises(ValueError, match="monostatic band"):
         SpectralSum(h.at_frequency(0), img.z, sand, model.options)
+    import holoradar.analysis.detect.kimage as kimage
+
+    saved = kimage.MAX_BYTES
+    kimage.MAX_BYTES = 1024                        # a volume too big to hold them: migrate
+    try:
+        with pytest.raises(ValueError, match="MiB"):
+            SpectralSum(h, img.z, sand, model.options)
+    finally:
+        kimage.MAX_BYTES = saved
     plane = hr.migrate(h, float(img.z[5]), medium=sand, upsample=2)
     single = HologramModel(h, as_volume(plane), sand, {})
     single.start()

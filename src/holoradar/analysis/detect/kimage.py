@@ -24,10 +24,14 @@ import numpy as np
 from ...data.hologram import Hologram
 from ...physics.medium import Medium
 
-__all__ = ["SpectralSum"]
+__all__ = ["MAX_BYTES", "SpectralSum"]
 
 _CHUNK = 16
 """Planes per batched inverse FFT."""
+
+MAX_BYTES = 512 * 2**20
+"""The transfer functions of all frequencies and planes are held while the model lives
+(nf nz My Mx complex numbers); beyond this ``migrate`` is used."""
 
 _OPTIONS = {"upsample", "equalize", "snr_db", "pad", "compensate_loss", "method", "dtype",
             "combine", "fov", "frame", "algorithm", "progress"}
@@ -52,7 +56,7 @@ class SpectralSum:
     ------
     ValueError
         When the sum does not apply (not a monostatic band, another method or field
-        of view).
+        of view, transfer functions over :data:`MAX_BYTES`).
     """
 
     def __init__(self, hologram: Hologram, zs: np.ndarray, medium: Medium | None,
@@ -82,6 +86,11 @@ class SpectralSum:
                                     compensate_loss=bool(opts.get("compensate_loss", True)),
                                     snr_db=float(opts["snr_db"]), monostatic=True)
                     for k in hologram.wavenumbers]
+        nz = np.atleast_1d(zs).size
+        held = sum(nz * op.fft_shape[0] * op.fft_shape[1] for op in self.ops) * work.itemsize
+        if held > MAX_BYTES:
+            raise ValueError(f"the frequencies' transfer functions ({held / 2**20:.0f} MiB) "
+                             f"exceed {MAX_BYTES / 2**20:.0f} MiB: migrate plane by plane")
         # Frequencies whose padded grids are alike share one inverse FFT per plane.
         self.groups: dict[tuple[int, int], list[int]] = {}
         for i, op in enumerate(self.ops):

@@ -46,6 +46,7 @@ from .smooth import LateralSmoother, gauss_1d, spline_matrix
 
 _opt = lazy_module("scipy.optimize")  # imported on first use: see holoradar._lazy
 _special = lazy_module("scipy.special")
+_fft = lazy_module("scipy.fft")
 
 __all__ = ["NoiseModel", "box_resels", "expected_false_peaks",
            "local_noise", "spectral_cells", "threshold", "threshold_resels"]
@@ -182,8 +183,9 @@ def _lateral_spread(data: np.ndarray, step: float, axis: int) -> float:
     w = np.hanning(n + 2)[1:-1]
     shape = [1, 1, 1]
     shape[axis] = n
-    F = np.fft.fft(data * w.reshape(shape), axis=axis)
-    P = np.sum(F.real ** 2 + F.imag ** 2, axis=tuple(a for a in range(3) if a != axis))
+    F = _fft.fft(data * w.reshape(shape), axis=axis, overwrite_x=True)
+    spec = "zyx,zyx->" + "zyx"[axis]
+    P = np.einsum(spec, F.real, F.real) + np.einsum(spec, F.imag, F.imag)
     p = 2 * np.pi * np.fft.fftfreq(n, step)
     if P.sum() <= 0:
         return np.nan
