@@ -229,3 +229,13 @@ def test_frequencies_sum_refused_where_it_does_not_apply(small):
     single = HologramModel(h, as_volume(plane), sand, {})
     single.start()
     assert single._sum is None                      # a plane: migrate itself
+
+
+def test_range_derivative_equals_numpy_gradient():
+    a = _field((7, 5, 6), seed=6)
+    z = 0.2 + np.arange(7) * 0.003
+    # The same differences and spacings: equal to rounding (a few ulps of a / dz).
+    assert np.allclose(nz_noise._dz(a, z), np.gradient(a, z, axis=0), rtol=1e-12,
+                       atol=1e-12 * np.abs(a).max() / 0.003)
+    zn = z + 0.0005 * np.arange(7) ** 2                # non-uniform planes: numpy's own
+    assert np.array_equal(nz_noise._dz(a, zn), np.gradient(a, zn, axis=0))

@@ -285,6 +285,21 @@ def _d5(a: np.ndarray, step: float, axis: int) -> np.ndarray:
     return np.moveaxis(d, -1, axis)
 
 
+def _dz(a: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``np.gradient(a, z, axis=0)``; on uniform planes by its formula written out
+    (central differences inside, one-sided on the first and last plane), without
+    the general case's temporaries."""
+    d = np.diff(z)
+    if np.ptp(d) > 1e-9 * abs(d[0]):
+        return np.gradient(a, z, axis=0)
+    out = np.empty_like(a)
+    np.subtract(a[2:], a[:-2], out=out[1:-1])
+    out[1:-1] *= 1.0 / (z[2] - z[0])
+    out[0] = (a[1] - a[0]) / d[0]
+    out[-1] = (a[-1] - a[-2]) / d[-1]
+    return out
+
+
 def _smooth(a: np.ndarray, w: np.ndarray, sx: float, sy: float) -> np.ndarray:
     """Normalised Gaussian smoothing of (nz, ny, nx) ``a`` laterally with weights ``w``
     (ny, nx): ``G*(w a) / G*w`` (pixels with w = 0 are left out), by FFT on every pixel
@@ -343,7 +358,7 @@ def local_noise(residual: np.ndarray, mask: np.ndarray, x: np.ndarray, y: np.nda
         return _LAST[1]
     nz, ny, nx = residual.shape
     dx, dy = float(x[1] - x[0]), float(y[1] - y[0])
-    gz_all = np.gradient(residual, z, axis=0) if nz >= 3 else None
+    gz_all = _dz(residual, z) if nz >= 3 else None
     cell, _ = _cells(residual, x, y, z, gz_all)
     cx = cell[0] if np.isfinite(cell[0]) else nx * dx
     cy = cell[1] if np.isfinite(cell[1]) else ny * dy
