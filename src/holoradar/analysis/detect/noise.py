@@ -461,8 +461,8 @@ def range_planes(z: np.ndarray, cell_z: float) -> np.ndarray:
 
     Examples
     --------
-    >>> range_planes(np.linspace(0.1, 0.3, 41), 0.04)[:4]
-    array([0, 4, 8, 12])
+    >>> range_planes(np.linspace(0.1, 0.3, 101), 0.04)[:4]   # 2 mm planes, 4 cm cell
+    array([0, 2, 4, 6])
     """
     nz = z.size
     if nz < 16 or not np.isfinite(cell_z):
