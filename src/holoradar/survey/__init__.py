@@ -1,11 +1,12 @@
-"""Surveys: many frames imaged with the same settings on Dask, stored together, mapped.
+"""Surveys: many frames imaged with the same settings, stored together, mapped.
 
 A survey is a set of hologram files (frames) recorded along a path. Three steps:
 
-* :func:`run_batch` images every frame with the same settings on Dask (a local
-  scheduler, or a ``dask.distributed`` cluster) into one Zarr store, each frame
-  with its world position; it skips (or, strict, stops at) frames it cannot
-  read, and a rerun resumes where a run stopped;
+* :func:`run_batch` images every frame with the same settings (in this process,
+  on a local cluster of worker processes, or on a ``dask.distributed`` cluster)
+  into one Zarr store, each frame with its world position; it skips (or,
+  strict, stops at) frames it cannot read, remembers them, and a rerun resumes
+  where a run stopped;
 * :func:`open_survey` opens the store as an ``xarray.Dataset``;
   :func:`frame_image` gives one frame's complex image; :func:`describe_store`
   says what a store holds (frames stored and missing, planes, settings);

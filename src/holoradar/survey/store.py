@@ -70,7 +70,7 @@ __all__ = [
 LAYOUT = "1"
 """Version of the store layout (attribute ``holoradar_survey``)."""
 
-_PER_FRAME = ("position", "finished", "done")  # one chunk per frame
+_PER_FRAME = ("position", "finished", "done")  # chunked along frame as the image
 _NAMES = ("frame_name", "frame_path")                               # written by the driver
 FRAME_ARRAYS = ("image", *_PER_FRAME, *_NAMES)
 _NAME_CHUNK = 1024

@@ -14,7 +14,7 @@ import threading
 import time
 import warnings
 from collections.abc import Sequence
-from concurrent.futures import Future, ThreadPoolExecutor, wait
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
@@ -79,10 +79,10 @@ def image_frame(path: str, name: str, job: Job,
     """Read and image one frame: ``(record, (image data, position))``, or ``(record,
     None)`` for a frame that cannot be imaged.
 
-    ``read``: the frame's :func:`read_frame` result, if it was read already (ahead, by
-    :func:`process_chunk`). The record is ``{"name", "status", ...}``: ``status``
-    ``"done"`` or ``"skipped"`` (with a ``reason``); with ``job.strict`` a frame that
-    cannot be imaged raises ``ValueError`` instead. Nothing is written here
+    ``read``: the frame's :func:`read_frame` result, if it was read already. The
+    record is ``{"name", "status", ...}``: ``status`` ``"done"`` or ``"skipped"``
+    (with a ``reason``); with ``job.strict`` a frame that cannot be imaged raises
+    ``ValueError`` instead. Nothing is written here
     (:func:`process_chunk` writes, and gathers the warnings).
     """
     holo, problem = read_frame(path, job.geometry, job.layout) if read is None else read
@@ -106,17 +106,6 @@ def image_frame(path: str, name: str, job: Job,
                              "finished so far are in the store)")
         return {"name": name, "status": "skipped", "reason": problem}, None
     return {"name": name, "status": "done"}, result
-
-
-_READER: list[ThreadPoolExecutor] = []
-
-
-def _read_ahead(path: str, job: Job) -> Future[tuple[Hologram | None, str | None]]:
-    """Read a frame on this process's reader thread while the caller images the last one
-    (the FFTs and array arithmetic of ``migrate`` release the GIL)."""
-    if not _READER:
-        _READER.append(ThreadPoolExecutor(1, thread_name_prefix="holoradar-survey-reader"))
-    return _READER[0].submit(read_frame, path, job.geometry, job.layout)
 
 
 class _Writer:
@@ -186,13 +175,13 @@ def drain_writes() -> int:
 def process_chunk(chunk: Sequence[tuple[int, str, str]], job: Job) -> list[dict[str, Any]]:
     """Image the frames ``(slot, path, name)`` of a task in turn, and store them.
 
-    Each frame is read on a thread while the one before it is imaged. The images are
-    gathered per chunk of the store and each chunk written once (images, positions and
-    times, then the ``done`` flags) on a writer thread, while the next frames are
-    imaged. After Ctrl-C (:func:`~holoradar.survey.schedule.stop_requested`), or when
-    a frame stops the run (``strict``) or anything raises, no further frame is
-    started: the frames imaged so far are written, the writes waited for, and only
-    then the task returns or raises. Records are :func:`image_frame`'s, with
+    The images are gathered per chunk of the store and each chunk written once
+    (images, positions and times, then the ``done`` flags) on a writer thread, while
+    the next frames are imaged. After Ctrl-C
+    (:func:`~holoradar.survey.schedule.stop_requested`), or when a frame stops the
+    run (``strict``) or anything raises, no further frame is started: the frames
+    imaged so far are written, the writes waited for, and only then the task returns
+    or raises. Records are :func:`image_frame`'s, with
     ``seconds`` (the frame's share of the task's time) and ``warnings`` (each
     distinct warning the task raised, once, as ``"Category: message"``, on its first
     record; a worker's own output is not the user's console).
@@ -207,22 +196,18 @@ def process_chunk(chunk: Sequence[tuple[int, str, str]], job: Job) -> list[dict[
     images: list[np.ndarray] = []
     positions: list[tuple[float, float, float]] = []
     ok = False
-    ahead: Future[Any] | None = None
     with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")  # (the reader thread's warnings are caught too)
+        warnings.simplefilter("always")
         try:
-            ahead = _read_ahead(chunk[0][1], job)
             t = time.perf_counter()
-            for i, (slot, path, name) in enumerate(chunk):
+            for slot, path, name in chunk:
                 if stop_requested(job.stop_file):  # the run was interrupted: leave the rest
                     break
                 if slot // per != group:  # a new chunk of the store: the last is complete
                     writer.submit(slots, images, positions)
                     slots, images, positions = [], [], []
                     group = slot // per
-                read = ahead.result()
-                ahead = _read_ahead(chunk[i + 1][1], job) if i + 1 < len(chunk) else None
-                rec, result = image_frame(path, name, job, read)
+                rec, result = image_frame(path, name, job)
                 now = time.perf_counter()
                 rec["seconds"], t = now - t, now
                 out.append(rec)
@@ -235,8 +220,6 @@ def process_chunk(chunk: Sequence[tuple[int, str, str]], job: Job) -> list[dict[
             # Whatever ended the task (its last frame, Ctrl-C, a strict stop): what was
             # imaged is handed to the writer; waited for here unless the caller drains.
             try:
-                if ahead is not None:
-                    wait([ahead])
                 writer.submit(slots, images, positions)
             finally:
                 if job.drain or not ok or stop_requested(job.stop_file):

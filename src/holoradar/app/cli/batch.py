@@ -1,4 +1,5 @@
-"""``holoradar batch`` (image every frame of a survey on Dask) and ``holoradar mosaic``."""
+"""``holoradar batch`` (image every frame of a survey, on one or more worker processes) and
+``holoradar mosaic``."""
 
 from __future__ import annotations
 
