@@ -71,3 +71,28 @@ def test_weak_ring_around_a_compact_object_is_absorbed_but_not_a_bars_pieces():
     plate = [pt(x, y, -3.0 * (abs(x) + abs(y)) / 0.02) for x in (-0.04, -0.02, 0, 0.02, 0.04)
              for y in (-0.02, 0, 0.02)]
     assert len(absorb_ringing(plate, cell)) == len(plate)
+
+
+def test_smuthi_sphere_under_a_tilted_array_is_one_point():
+    # SMUTHI S7: a metal sphere (radius 12 mm, centre 12 cm deep in sand) seen by a
+    # 24 x 24 array at 15 mm tilted 40 degrees, its centre 0.5 m from the sphere along
+    # its normal, one frequency; imaged in the ground frame on the plane of the
+    # sphere's bright point (its surface facing the array, centre - r * the refracted
+    # viewing direction; frames as in tests/test_oblique.py). One point there, within
+    # a quarter of the array's lateral resolution lambda L / A (L = 0.5 m, A = 0.36 m).
+    d = np.load(DATA / "S7_tilted_array_sphere.npz")
+    surf, c = 0.4, d["centre_m"]
+    pose = hr.Pose((c[0], c[1], surf - c[2]), tilt=np.radians(40), azimuth=np.radians(90))
+    h = hr.Hologram(d["E_scat"][0], d["x_local_m"], d["y_local_m"], 9.9e9, pose=pose)
+    eps = 2.5 + 0.0125j
+    med = hr.Medium.half_space(surf, eps)
+    sin_t = np.sin(np.radians(40)) / np.sqrt(eps.real)
+    bright = np.array([-0.03, 0.02, surf + 0.12]) - 0.012 * np.array(
+        [0.0, sin_t, np.sqrt(1 - sin_t**2)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        img = hr.migrate(h, bright[2], medium=med, frame="ground", upsample=3)
+    df = hr.detect(img, medium=med)
+    assert list(df.kind) == ["point"], df[["kind", "x", "y", "amplitude_db", "snr_db"]]
+    quarter = hr.theory.lateral_resolution(hr.C0 / 9.9e9, 0.5, 0.36) / 4
+    assert np.hypot(df.x[0] - bright[0], df.y[0] - bright[1]) < quarter

@@ -207,7 +207,8 @@ def _rows(result: CleanResult, vol: Volume, model: Any, medium: Any,
             mu, nu = model.widths(pos[2])
             snr_lin = amp2 / s2 if s2 > 0 else np.inf
             # Cramer-Rao of a peak's position: 1/sqrt(2 SNR beta^2), beta^2 = mu^2/3.
-            std = (np.sqrt(3 / (2 * snr_lin)) / mu, np.sqrt(3 / (2 * snr_lin)) / nu, np.nan)
+            k = np.sqrt(3 / (2 * snr_lin)) if snr_lin > 0 else np.inf
+            std = (k / mu, k / nu, np.nan)
         depth = lo = hi = np.nan
         if medium is not None and medium.z_interfaces:
             z0 = float(medium.z_interfaces[0])

@@ -20,6 +20,7 @@ class Volume:
     z: np.ndarray
     frequency: Any
     planar: bool
+    method: str = ""       # the image's ``method`` (":ground": a tilted array's ground frame)
 
     @property
     def dx(self) -> float:
@@ -83,7 +84,8 @@ def as_volume(image: Any) -> Volume:
         raise ValueError("image.data must be finite")
     if z.size > 1 and np.any(np.diff(z) <= 0):
         raise ValueError("image.z must be increasing (metres)")
-    return Volume(vol.astype(complex), x, y, z, getattr(image, "frequency", None), not has_z)
+    return Volume(vol.astype(complex), x, y, z, getattr(image, "frequency", None), not has_z,
+                  str(getattr(image, "method", "") or ""))
 
 
 def refine_peak(p: np.ndarray, index: tuple[int, int, int]) -> tuple[np.ndarray, float]:

@@ -236,7 +236,11 @@ class ApertureModel:
 
     @staticmethod
     def applies(volume: Volume) -> bool:
-        """One plane at one frequency on a grid some aperture's pitch divides."""
+        """One plane at one frequency on a grid some aperture's pitch divides, imaged
+        from a level array (not a tilted array's ground frame: its elements are not on
+        the image's grid)."""
+        if volume.method.endswith(":ground"):
+            return False
         f = np.atleast_1d(volume.frequency) if volume.frequency is not None else np.array([])
         if volume.z.size != 1 or f.size != 1 or not np.isfinite(f[0]) or f[0] <= 0:
             return False

@@ -10,7 +10,11 @@ A point focused at its own range through a rectangular aperture of full widths
 ``sinc(u) = sin(u)/u`` (first sidelobe 13.3 dB down), with the phase ramp
 ``(p_c, q_c)`` of the point's view of the array measured from the image at the
 peak. ``A`` and ``B`` are taken as the image's extent (a frontal image spans the
-aperture), ``k`` at the mean frequency. Without the hologram the range response
+aperture), ``k`` at the mean frequency. A tilted array's ground-frame image spans
+more than its aperture's footprint, and its window is stretched along the tilt:
+there ``mu`` and ``nu`` are the image's own spectral widths, ``pi / c`` with ``c``
+the cell of the equivalent uniform band (:func:`~.noise.spectral_cells`: the band
+whose spectral variance is the image's). Without the hologram the range response
 is not modelled: the window's amplitude is fitted plane by plane over the main
 lobe, which removes the object's smear along range with it.
 """
@@ -51,6 +55,13 @@ class WindowModel:
         self.medium = medium
         self.A = volume.x.size * volume.dx
         self.B = volume.y.size * volume.dy
+        self.fixed: tuple[float, float] | None = None
+        if volume.method.endswith(":ground"):
+            from .noise import spectral_cells
+
+            (cx, cy, _), _ = spectral_cells(volume.data, volume.x, volume.y, volume.z)
+            if np.isfinite(cx) and np.isfinite(cy) and cx > 0 and cy > 0:
+                self.fixed = (np.pi / cx, np.pi / cy)
 
     def start(self) -> np.ndarray:
         """The residual to begin with: the image itself."""
@@ -58,6 +69,8 @@ class WindowModel:
 
     def widths(self, z: float) -> tuple[float, float]:
         """``(mu, nu)`` at range ``z``, rad/m."""
+        if self.fixed is not None:
+            return self.fixed
         L = self.medium.apparent_distance(z) if self.medium is not None else z
         L = max(L, 1e-3)
         return self.k * self.A / (2 * L), self.k * self.B / (2 * L)
