@@ -10,6 +10,8 @@ $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[test]'
+	@# The compiled wavenumber-domain loops (numba) built once here, not on a first call.
+	$(BIN)/python -c "from holoradar.imaging import columns; columns.warm()"
 	@touch $(STAMP)
 
 demo: $(STAMP)
@@ -45,7 +47,7 @@ test-slow: $(STAMP)
 # The documentation's pictures of the viewer, taken by its browser tests.
 screenshots: $(STAMP) browser
 	HOLORADAR_SCREENSHOTS=docs/figures MPLBACKEND=Agg $(BIN)/python -m pytest -q \
-	  tests/test_viewer_browser.py
+	  -m "browser" tests/test_viewer_browser.py tests/test_report_browser.py
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # what static checkers and IDEs see
     from . import calibrate, survey, theory
     from ._validate import AliasingWarning
-    from .analysis.detect import detect
+    from .analysis.detect import detect, rebar_layers
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
     from .app.report import report
     from .data.hologram import C0, Hologram, Image
@@ -85,6 +85,7 @@ _NAMES = {
     "check_iq_sign": ".imaging.iq",
     "conjugate": ".data.wideband",
     "detect": ".analysis.detect",
+    "rebar_layers": ".analysis.detect",
     "estimate_permittivity": ".imaging.glare",
     "iq_convention": ".imaging.iq",
     "load": ".io",
@@ -158,6 +159,7 @@ __all__ = [
     "permittivity",
     "plan_oblique",
     "remove_mean",
+    "rebar_layers",
     "report",
     "save",
     "simulate",
