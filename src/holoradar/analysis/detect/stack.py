@@ -87,7 +87,8 @@ def detect_planes(vol: Volume, run_plane: PlaneSearch, false_alarm: float,
     found: list[tuple[int, dict[str, Any]]] = []
     thresholds, lateral, cells, kind = [], [], [], "window"
     for iz in range(vol.z.size):
-        plane = Volume(vol.data[iz:iz + 1], vol.x, vol.y, vol.z[iz:iz + 1], vol.frequency, True)
+        plane = Volume(vol.data[iz:iz + 1], vol.x, vol.y, vol.z[iz:iz + 1], vol.frequency, True,
+                       vol.method)
         rows, result, kind = run_plane(plane, fa_plane)
         thresholds.append(float(result.noise.t))
         lateral.append(float(result.noise.n_cells))
@@ -102,7 +103,6 @@ def detect_planes(vol: Volume, run_plane: PlaneSearch, false_alarm: float,
     out = [_place(iz, row, vol, cz, medium, interval) for iz, row in objects]
     extent = float(vol.z[-1] - vol.z[0]) * vol.z.size / (vol.z.size - 1)
     n_range = max(extent / cz, 1.0) if np.isfinite(cz) else 1.0
-
     meta = {"threshold": float(np.median(thresholds)), "resolution_cell": [cx, cy, cz],
             "n_cells": float(noise3.n_cells), "model": f"{kind}, by planes",
             "planes": int(vol.z.size), "false_alarm_per_plane": fa_plane,
