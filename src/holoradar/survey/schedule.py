@@ -272,14 +272,16 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
     Each worker imports what a task needs as it starts
     (:mod:`holoradar.survey.warm`: the imaging code, SciPy's FFT, h5py, Zarr),
     while the caller lays out the store, and ignores Ctrl-C (the caller stops the
-    tasks). No dashboard; the cluster's own log lines are silenced below errors.
+    tasks). No dashboard; the cluster's own log lines are silenced (a worker's
+    heartbeat error as the scheduler stops on Ctrl-C reached the terminal; the tasks'
+    errors come back through their futures).
     """
     import logging
 
     from distributed import Client, LocalCluster
 
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=":0", silence_logs=logging.ERROR,
+                           dashboard_address=":0", silence_logs=logging.CRITICAL,
                            preload=["holoradar.survey.warm"])
     try:
         client = Client(cluster, set_as_default=False)

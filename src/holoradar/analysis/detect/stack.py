@@ -12,7 +12,9 @@ plane), and the rows found at the same lateral place in several planes (the same
 kind: points within a lateral cell, lines parallel and within a cell across, areas
 within a cell or half their width) are one object, taken from the plane where it is
 brightest; a point lying on a line (within a cell of its axis and extent: a piece
-of it, or of a crossing bar, brighter on another plane) is part of that line. Its
+of it, or of a crossing bar, brighter on another plane) is part of that line, and
+a point or a smaller area within a cell of a brighter area's outline is part of
+that area (each plane explains an area by other components). Its
 range is the maximum of its range profile, sampled from the volume
 at its position (a line's or area's along its extent), refined by a parabola
 through the logarithm of the three samples around it; its range standard deviation
@@ -44,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from ...data.hologram import C0
+from .areas import _inside
 from .grid import Volume
 from .table import depth_interval
 
@@ -172,8 +175,32 @@ def _merge(found: list[tuple[int, dict[str, Any]]], cell: float
         if not any(_same(k, row, cell) for _, k in kept):
             kept.append((iz, row))
     lines = [k for _, k in kept if k["kind"] == "line"]
-    return [(iz, r) for iz, r in kept
+    kept = [(iz, r) for iz, r in kept
             if r["kind"] != "point" or not any(_on_line(r, ln, cell) for ln in lines)]
+    # An area seen on several planes comes with different components each time: the
+    # points and smaller areas within a cell of a brighter area's outline are it.
+    out: list[tuple[int, dict[str, Any]]] = []
+    for iz, r in kept:
+        if r["kind"] in ("point", "area") and any(
+                _in_area(r, a, cell) for _, a in out if a["kind"] == "area"):
+            continue
+        out.append((iz, r))
+    return out
+
+
+def _in_area(row: dict[str, Any], area: dict[str, Any], cell: float) -> bool:
+    """Whether a row's position lies in an area's outline or within a cell of it."""
+    ring = np.asarray(area.get("outline") or [], float)
+    if ring.ndim != 2 or len(ring) < 3:
+        return bool(np.hypot(row["x"] - area["x"], row["y"] - area["y"]) < cell)
+    q = np.array([row["x"], row["y"]])
+    if bool(_inside(ring, q[None])[0]):
+        return True
+    a, b = ring, np.roll(ring, -1, axis=0)
+    ab = b - a
+    t = np.clip(np.sum((q - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300),
+                0.0, 1.0)
+    return bool(np.min(np.hypot(*(a + t[:, None] * ab - q).T)) < cell)
 
 
 def _on_line(p: dict[str, Any], line: dict[str, Any], cell: float) -> bool:
