@@ -172,3 +172,18 @@ def test_rebar_layers_groups_directions_across_0_and_180_degrees():
         rebar_layers(pd.DataFrame(rows), angle_tol_deg=95)
     with pytest.raises(ValueError, match="objects must be"):
         rebar_layers([1, 2])
+
+
+def test_an_area_seen_on_several_planes_is_one_area():
+    # Each plane explains a disk by other components: the points and smaller areas
+    # within a cell of the brightest area's outline are that area; a point two cells
+    # beyond its edge is another object.
+    cell = 0.02
+    ring = [[-0.04, -0.04], [0.04, -0.04], [0.04, 0.04], [-0.04, 0.04]]
+    found = [(5, _row("area", 0.0, 0.0, 6.0, outline=ring, width=0.08)),
+             (4, _row("point", 0.03, 0.01, 3.0)),                  # inside
+             (6, _row("point", 0.055, 0.0, 2.0)),                  # 1.5 cm off its edge
+             (3, _row("area", 0.01, 0.0, 1.0, outline=ring, width=0.06)),
+             (4, _row("point", 0.09, 0.0, 2.5))]                   # 2.5 cells off its edge
+    kept = _merge(found, cell)
+    assert [(r["kind"], r["x"]) for _, r in kept] == [("area", 0.0), ("point", 0.09)]
