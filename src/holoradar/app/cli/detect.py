@@ -481,23 +481,35 @@ def _medium_dict(medium: Any) -> Any:
                     for e in medium.eps]}
 
 
+def detection_options(f: Any) -> Any:
+    """The options that say what to search and how (``detect`` and ``report``): the
+    planes of a hologram (``--z``), the ground, its permittivity interval, the
+    false-alarm rate and the kinds."""
+    for opt in reversed([
+        click.option("--z", "z", default=None,
+                     help="A hologram FILE: the planes to image it on (m: 0.4 or "
+                          "start:stop:step). An image volume or a survey store: the one "
+                          "plane to search from the image alone."),
+        medium_options,
+        click.option("--eps-interval", default=None, metavar="LO,HI",
+                     help="Interval of the ground's real permittivity, e.g. 2.2,2.8: widens "
+                          "the depth interval (needs a ground)."),
+        click.option("--false-alarm", default="1e-3", show_default=True, metavar="P",
+                     help="Expected false objects per resolution cell on noise: sets the "
+                          "threshold from the image's own noise."),
+        click.option("--kinds", default="point,line,area", show_default=True,
+                     metavar="KIND,...",
+                     help="Which kinds of object to report: point, line, area."),
+    ]):
+        f = opt(f)
+    return f
+
+
 # ---------------------------------------------------------------- the command
 
 @click.command()
 @click.argument("file", type=click.Path(exists=True, path_type=Path))
-@click.option("--z", "z", default=None,
-              help="A hologram FILE: the planes to image it on (m: 0.4 or start:stop:step). "
-                   "An image volume or a survey store: the one plane to search from the "
-                   "image alone.")
-@medium_options
-@click.option("--eps-interval", default=None, metavar="LO,HI",
-              help="Interval of the ground's real permittivity, e.g. 2.2,2.8: widens the "
-                   "depth interval (needs a ground).")
-@click.option("--false-alarm", default="1e-3", show_default=True, metavar="P",
-              help="Expected false objects per resolution cell on noise: sets the threshold "
-                   "from the image's own noise.")
-@click.option("--kinds", default="point,line,area", show_default=True, metavar="KIND,...",
-              help="Which kinds of object to report: point, line, area.")
+@detection_options
 @click.option("--hologram", type=click.Path(exists=True, dir_okay=False, path_type=Path),
               default=None,
               help="An image FILE's hologram (the file it was imaged from): each object is "

@@ -13,7 +13,8 @@ from typing import Any
 
 import click
 
-from .common import Reporter, layout_option, medium_options, output_options
+from .common import Reporter, layout_option, output_options
+from .detect import detection_options
 
 __all__ = ["COMMANDS"]
 
@@ -46,19 +47,7 @@ def _medium(files: list[Path], spec: dict[str, Any], layout: str | None, check: 
                 type=click.Path(exists=True, path_type=Path), metavar="FILE...")
 @click.option("-o", "--out", type=click.Path(dir_okay=False, path_type=Path), required=True,
               help="The report: an .html file (one file, pictures embedded, no network).")
-@click.option("--z", "z", default=None,
-              help="A hologram FILE: the planes to image it on (m: 0.4 or start:stop:step). "
-                   "An image volume or a survey store: the one plane to search from the "
-                   "image alone.")
-@medium_options
-@click.option("--eps-interval", default=None, metavar="LO,HI",
-              help="Interval of the ground's real permittivity, e.g. 2.2,2.8: widens the "
-                   "depth interval (needs a ground).")
-@click.option("--false-alarm", default="1e-3", show_default=True, metavar="P",
-              help="Expected false objects per resolution cell on noise: sets the threshold "
-                   "from the image's own noise.")
-@click.option("--kinds", default="point,line,area", show_default=True, metavar="KIND,...",
-              help="Which kinds of object to report: point, line, area.")
+@detection_options
 @click.option("--hologram", type=click.Path(exists=True, dir_okay=False, path_type=Path),
               default=None,
               help="An image FILE's hologram (the file it was imaged from): each object is "
