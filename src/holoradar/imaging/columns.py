@@ -34,8 +34,9 @@ from typing import Any
 
 import numpy as np
 
+from .. import _threads
 from .._lazy import lazy_module
-from .._threads import POOL_SIZE, pool
+from .._threads import fft_workers, pool
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import _CACHE, padded_shape
@@ -177,7 +178,7 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
     """
     live = np.flatnonzero(plan.bend >= j0)
     work = int(np.minimum(plan.bend[live] + 1, j1).sum() - j0 * live.size) * plan.nf * _COLS
-    nt = min(POOL_SIZE, live.size)
+    nt = min(_threads.POOL_SIZE, live.size)
     if nt < 2 or work < _THREADED_TERMS:
         kernel(ar, ai, plan.sr, plan.si, plan.jm, plan.bend, plan.pos, live, plan.live.size,
                j0, j1, zero, outv)
@@ -229,7 +230,7 @@ def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights:
     real = np.float32 if work == np.complex64 else np.float64
     lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
     grid = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam, z_max=float(zs.max()))
-    workers = -1 if grid[0] * grid[1] >= 128 * 128 else 1
+    workers = fft_workers(grid[0] * grid[1])
     weights = np.asarray(weights, dtype=float)
     u = int(upsample)
     direct = u == 1 and grid == (ny, nx)

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._lazy import lazy_module
+from .._threads import fft_workers
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import (
@@ -86,7 +87,7 @@ def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: 
     fft_shape = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam,
                              z_max=float(zs.max()))
     My, Mx = fft_shape
-    workers = -1 if My * Mx >= 128 * 128 else 1
+    workers = fft_workers(My * Mx)
     weights = np.asarray(weights, dtype=float)
     key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in hologram.wavenumbers),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, phase_incident,

@@ -16,8 +16,9 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import _threads
 from .._lazy import lazy_module
-from .._threads import POOL_SIZE, pool
+from .._threads import pool
 from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
 from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
@@ -510,12 +511,12 @@ def _multiply_planes(H: np.ndarray, Ucs: list[np.ndarray], prod: np.ndarray) -> 
     0.23 ms shared among two) the threads' hand-offs cost more than they share.
     """
     rows = H.shape[-2]
-    if POOL_SIZE < 2 or len(Ucs) * H.size < _THREADED_MULTIPLY:
+    if _threads.POOL_SIZE < 2 or len(Ucs) * H.size < _THREADED_MULTIPLY:
         for i, Uc in enumerate(Ucs):   # small: threads cost more than they share
             np.multiply(H, Uc, out=prod[..., i, :, :])
         return
     # Tasks: (plane, row block); a single plane is split in row blocks across cores.
-    blocks = max(1, -(-POOL_SIZE // len(Ucs))) if rows >= 64 else 1
+    blocks = max(1, -(-_threads.POOL_SIZE // len(Ucs))) if rows >= 64 else 1
     edges = np.linspace(0, rows, blocks + 1).astype(int)
     tasks = [(i, slice(edges[b], edges[b + 1])) for i in range(len(Ucs)) for b in range(blocks)]
 
@@ -523,7 +524,7 @@ def _multiply_planes(H: np.ndarray, Ucs: list[np.ndarray], prod: np.ndarray) -> 
         i, r = task
         np.multiply(H[..., r, :], Ucs[i][r, :], out=prod[..., i, r, :])
 
-    if len(tasks) < 2 or POOL_SIZE < 2:
+    if len(tasks) < 2 or _threads.POOL_SIZE < 2:
         for t in tasks:
             work(t)
         return

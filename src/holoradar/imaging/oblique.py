@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from .._lazy import lazy_module
+from .._threads import fft_workers
 from .._validate import as_axis, uniform_step
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
@@ -169,7 +170,7 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
     H = _spectrum_on_plane(hologram, grid, (dcx, dcy), (xo[0], yo[0], z_ref), work, gap,
                            route)
     out = np.empty((*H.shape[:-2], zs.size, yo.size, xo.size), dtype=work)
-    workers = -1 if grid[0] * grid[1] * ux * uy >= 128 * 128 else 1
+    workers = fft_workers(grid[0] * grid[1] * ux * uy)
     for j, z in enumerate(zs):
         Uc = _ground_transfer(grid, (dcx, dcy), k, shifted, float(z - z_ref), rise, mono,
                               reach, work, compensate_loss)

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from .._lazy import lazy_module
+from .._threads import fft_workers
 from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import padded_shape
@@ -131,7 +132,7 @@ def migrate_stolt(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: n
     lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
     grid = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam, z_max=float(zs.max()))
     My, Mx = grid
-    workers = -1 if My * Mx >= 128 * 128 else 1
+    workers = fft_workers(My * Mx)
     nz = zs.size
     dz = float(zs[1] - zs[0])
     w = np.asarray(weights, dtype=float)

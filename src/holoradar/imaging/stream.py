@@ -22,6 +22,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._lazy import lazy_module
+from .._threads import fft_workers
 from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram, Image
 from ..physics.incident import incident_on_plane
@@ -207,7 +208,8 @@ class StreamImager:
         P = H * self.uc
         if self.u > 1:
             P = self._embed(P)
-        g = sfft.ifft2(P, axes=(-2, -1), workers=-1, overwrite_x=self.u == 1)
+        g = sfft.ifft2(P, axes=(-2, -1), workers=fft_workers(P.shape[-2] * P.shape[-1]),
+                       overwrite_x=self.u == 1)
         np.multiply(g, self.phasors, out=g)
         img = g.sum(axis=0)
         img = np.roll(img, self.roll, axis=(0, 1))

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._lazy import lazy_module
+from .._threads import fft_workers
 from .medium import Medium
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
@@ -456,7 +457,7 @@ class _PlaneOperator(ABC):
     @property
     def workers(self) -> int:
         """FFT threads: all cores, except for small grids where threads cost more."""
-        return -1 if self.fft_shape[0] * self.fft_shape[1] >= 128 * 128 else 1
+        return fft_workers(self.fft_shape[0] * self.fft_shape[1])
 
     def _fft(self, a: np.ndarray) -> np.ndarray:
         My, Mx = self.fft_shape
@@ -588,5 +589,5 @@ class Fresnel(_PlaneOperator):
         # sampling limit of the impulse-response method).
         kern = np.where((np.abs(ox[None, :]) * k / L <= np.pi / self.dx)
                         & (np.abs(oy[:, None]) * k / L <= np.pi / self.dy), kern, 0)
-        U = sfft.fft2(kern, workers=-1)
+        U = sfft.fft2(kern, workers=fft_workers(kern.shape[-2] * kern.shape[-1]))
         return (U.conj() if conjugate else U).astype(self.dtype, copy=False)

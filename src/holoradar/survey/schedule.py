@@ -265,6 +265,12 @@ def _run_on_cluster(func: Any, tasks: list[list[Any]], job: Any, client: Any, *,
     return out
 
 
+WORKER_ENV = {"HOLORADAR_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+              "MKL_NUM_THREADS": "1"}
+"""The environment of a local cluster's workers: one thread each for holoradar's
+FFTs and pool, and for BLAS."""
+
+
 def local_cluster(workers: int) -> tuple[Any, Any]:
     """A ``dask.distributed.LocalCluster`` of ``workers`` processes of one thread each, and
     its client, for one run (the caller closes both). Its dashboard takes a free port.
@@ -272,9 +278,11 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
     Each worker imports what a task needs as it starts
     (:mod:`holoradar.survey.warm`: the imaging code, SciPy's FFT, h5py, Zarr),
     while the caller lays out the store, and ignores Ctrl-C (the caller stops the
-    tasks). No dashboard; the cluster's own log lines are silenced (a worker's
-    heartbeat error as the scheduler stops on Ctrl-C reached the terminal; the tasks'
-    errors come back through their futures).
+    tasks), and runs its FFTs and BLAS on one thread (:data:`WORKER_ENV`: N workers
+    on N cores, not N x N threads waiting on one another). No dashboard; the
+    cluster's own log lines are silenced (a worker's heartbeat error as the scheduler
+    stops on Ctrl-C reached the terminal; the tasks' errors come back through their
+    futures).
     """
     import logging
 
@@ -282,7 +290,7 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
 
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=":0", silence_logs=logging.CRITICAL,
-                           preload=["holoradar.survey.warm"])
+                           preload=["holoradar.survey.warm"], env=WORKER_ENV)
     try:
         client = Client(cluster, set_as_default=False)
     except BaseException:

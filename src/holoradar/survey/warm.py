@@ -13,14 +13,18 @@ import signal
 import threading
 from typing import Any
 
+from .. import _threads
 from .worker import warm
 
 __all__ = ["dask_setup"]
 
+_threads.apply_environment()
 warm()
 
 
 def dask_setup(worker: Any) -> None:
-    """A ``dask.distributed`` worker's preload hook: leave Ctrl-C to the caller."""
+    """A ``dask.distributed`` worker's preload hook: leave Ctrl-C to the caller, and
+    take the thread limit its environment sets (``HOLORADAR_THREADS``)."""
+    _threads.apply_environment()
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
