@@ -31,7 +31,7 @@ from holoradar.survey import worker as survey_worker
 F0 = 9.9e9
 PITCH = 0.01          # < lambda/2 = 1.51 cm at 9.9 GHz: no aliasing warning
 Z = [0.05, 0.1]       # two planes
-N_CLUSTER = 200
+N_CLUSTER = 120       # frames of the module's survey (the killed-process test uses them all)
 
 
 def _frames(folder: Path, n: int, size: int = 8, seed: int = 0) -> tuple[list[Path], list]:
@@ -49,7 +49,7 @@ def _frames(folder: Path, n: int, size: int = 8, seed: int = 0) -> tuple[list[Pa
 
 
 @pytest.fixture(scope="module")
-def survey200(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[Path], list]:
+def survey_frames(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[Path], list]:
     return _frames(tmp_path_factory.mktemp("frames"), N_CLUSTER)
 
 
@@ -74,13 +74,13 @@ def _assert_exact(store: Path, paths: list[Path], holos: list, **kw) -> np.ndarr
 # (a) a dask.distributed cluster of 2 worker processes gives the single-process results
 @pytest.mark.slow  # a real two-process cluster takes 15 s to start and run; the default
 # process scheduler's test below covers the same equality across processes
-def test_cluster_of_two_workers_equals_single_process(survey200, tmp_path: Path) -> None:
+def test_cluster_of_two_workers_equals_single_process(survey_frames, tmp_path: Path) -> None:
     from distributed import LocalCluster
 
-    paths, holos = survey200
+    paths, holos = survey_frames
     # The files hold the holograms bit for bit (so migrating the ones in memory is the
     # single-process result of each file); checked on a few.
-    for i in (0, 99, 199):
+    for i in (0, N_CLUSTER // 2, N_CLUSTER - 1):
         assert np.array_equal(hr.load(paths[i]).data, holos[i].data)
     store = tmp_path / "survey.zarr"
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
@@ -96,8 +96,8 @@ def test_cluster_of_two_workers_equals_single_process(survey200, tmp_path: Path)
 
 
 # (b) corrupt, truncated, empty and foreign frames: reported by name and skipped; strict stops
-def test_bad_frames_are_reported_and_skipped(survey200, tmp_path: Path) -> None:
-    paths, holos = survey200
+def test_bad_frames_are_reported_and_skipped(survey_frames, tmp_path: Path) -> None:
+    paths, holos = survey_frames
     good = paths[:4]
     truncated = tmp_path / "truncated.nc"
     truncated.write_bytes(paths[4].read_bytes()[: paths[4].stat().st_size // 2])
@@ -136,9 +136,9 @@ def test_bad_frames_are_reported_and_skipped(survey200, tmp_path: Path) -> None:
 
 
 # (c) a rerun resumes: frames already done are not imaged again
-def test_rerun_resumes_without_redoing(survey200, tmp_path: Path,
+def test_rerun_resumes_without_redoing(survey_frames, tmp_path: Path,
                                        monkeypatch: pytest.MonkeyPatch) -> None:
-    paths, holos = survey200
+    paths, holos = survey_frames
     calls = []
     real = survey_worker.migrate
 
@@ -162,11 +162,11 @@ def test_rerun_resumes_without_redoing(survey200, tmp_path: Path,
 
 
 # (d) a run cut short leaves a readable store; the rerun completes it
-def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
+def test_interrupted_run_leaves_readable_store(survey_frames, tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
     from holoradar.survey import batch as survey_batch
 
-    paths, holos = survey200
+    paths, holos = survey_frames
     frames = paths[:12]
     # Chunks of 4 frames: the second chunk's images are written, then the run "dies"
     # before their positions and done flags (a KeyboardInterrupt in the writer).
@@ -205,13 +205,13 @@ def test_interrupted_run_leaves_readable_store(survey200, tmp_path: Path,
     assert _assert_exact(store, paths, holos).all()
 
 
-def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
+def test_after_ctrl_c_workers_start_no_further_frame(survey_frames, tmp_path: Path,
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     """After Ctrl-C the caller asks the workers to stop (schedule.stop_requested): a task
     finishes the frame in hand and starts no other; the next run starts afresh."""
     from holoradar.survey import schedule
 
-    paths, holos = survey200
+    paths, holos = survey_frames
     real = survey_worker.image_frame
     calls = []
 
@@ -235,8 +235,8 @@ def test_after_ctrl_c_workers_start_no_further_frame(survey200, tmp_path: Path,
     assert (s["resumed"], s["done"]) == (1, 3)  # the stop does not outlive its run
 
 
-def test_killed_process_leaves_readable_store(survey200, tmp_path: Path) -> None:
-    paths, holos = survey200
+def test_killed_process_leaves_readable_store(survey_frames, tmp_path: Path) -> None:
+    paths, holos = survey_frames
     frames = paths[:120]
     store = tmp_path / "s.zarr"
     listing = tmp_path / "frames.txt"
@@ -269,14 +269,14 @@ def test_killed_process_leaves_readable_store(survey200, tmp_path: Path) -> None
     assert _assert_exact(store, paths, holos).all()
 
 
-def test_images_are_compressed_and_plain_stores_still_work(survey200, tmp_path: Path,
+def test_images_are_compressed_and_plain_stores_still_work(survey_frames, tmp_path: Path,
                                                             monkeypatch: pytest.MonkeyPatch
                                                             ) -> None:
     """New stores compress the images (Blosc LZ4, shuffled); a store written before
     (plain chunks) is read and resumed as it is, exactly."""
     import zarr
 
-    paths, holos = survey200
+    paths, holos = survey_frames
     new = tmp_path / "new.zarr"
     hr.survey.run_batch(paths[:3], new, z=Z, scheduler="synchronous")
     codecs = zarr.open_array(str(new / "image"), mode="r").compressors
@@ -298,13 +298,13 @@ def test_images_are_compressed_and_plain_stores_still_work(survey200, tmp_path: 
                                   hr.migrate(holos[4], Z).data)
 
 
-def test_size_is_said_before_and_a_full_disk_refused(survey200, tmp_path: Path,
+def test_size_is_said_before_and_a_full_disk_refused(survey_frames, tmp_path: Path,
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     import shutil as sh
 
     from holoradar.survey import batch as survey_batch
 
-    paths, _ = survey200
+    paths, _ = survey_frames
     per = 2 * 8 * 8 * 2 * 8  # 2 planes of 8 x 8 pixels, I and Q as float64
     plans = []
     store = tmp_path / "s.zarr"
@@ -382,8 +382,8 @@ def test_mosaic_places_a_point_target(tmp_path: Path) -> None:
 
 
 # (f) refusals, before any work
-def test_refusals(survey200, tmp_path: Path) -> None:
-    paths, _ = survey200
+def test_refusals(survey_frames, tmp_path: Path) -> None:
+    paths, _ = survey_frames
     frame_as_zarr = tmp_path / "frame.zarr"
     shutil.copy(paths[0], frame_as_zarr)
     with pytest.raises(ValueError, match="one of the inputs"):
@@ -423,10 +423,10 @@ def test_refusals(survey200, tmp_path: Path) -> None:
     assert not (tmp_path / "t.zarr").exists()
 
 
-def test_default_and_dask_local_schedulers(survey200, tmp_path: Path) -> None:
+def test_default_and_dask_local_schedulers(survey_frames, tmp_path: Path) -> None:
     """By default a short survey stays in the caller's process (a cluster would take
     longer to start than the frames to image); Dask's local schedulers still work."""
-    paths, holos = survey200
+    paths, holos = survey_frames
     s = hr.survey.run_batch(paths[:16], tmp_path / "d.zarr", z=Z)
     assert (s["scheduler"], s["workers"], s["done"]) == ("in-process", 1, 16)
     assert _assert_exact(tmp_path / "d.zarr", paths, holos).all()
@@ -444,10 +444,10 @@ _DAMAGED = {"n": 0}
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
-def test_damaged_stores_give_a_clear_error(survey200, tmp_path: Path, data) -> None:
+def test_damaged_stores_give_a_clear_error(survey_frames, tmp_path: Path, data) -> None:
     """A store whose files were truncated, flipped or removed: reading it (open_survey,
     mosaic, frame_image) is a ValueError or a valid answer, never another exception."""
-    paths, _ = survey200
+    paths, _ = survey_frames
     base = tmp_path / "base.zarr"
     if not base.exists():
         hr.survey.run_batch(paths[:3], base, z=0.3, scheduler="synchronous")
