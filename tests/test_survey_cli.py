@@ -60,11 +60,11 @@ def test_ctrl_c_during_batch_is_one_line_and_exit_130(tmp_path: Path, workers: s
     """SIGINT to the process group, as a terminal's Ctrl-C sends it (the workers of a
     local cluster included): one line saying how many frames are stored (the store's
     own count) and that a rerun resumes; exit code 130; no traceback."""
-    # 60 copies of one frame, a tenth of a second or more each: seconds of work in all,
+    # 200 copies of one frame, a tenth of a second or more each: many seconds of work,
     # interrupted once two are stored (where the frames lie does not matter here).
     one = _frames(tmp_path / "one", 1, size=16)[0]
     (tmp_path / "s").mkdir()
-    frames = [shutil.copyfile(one, tmp_path / "s" / f"f{i:03d}.nc") for i in range(60)]
+    frames = [shutil.copyfile(one, tmp_path / "s" / f"f{i:03d}.nc") for i in range(200)]
     store = tmp_path / "s.zarr"
     args = ["batch", str(tmp_path / "s" / "*.nc"), "-o", str(store), "--z", "0.05:0.35:0.01",
             "--upsample", "8", "--workers", workers]
