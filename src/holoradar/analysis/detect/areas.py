@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from .lines import END_DB, LINK_CELLS, lateral_cell
+from .lines import END_DB, LINK_CELLS, point_components
 
 __all__ = ["convex_hull", "group_areas", "polygon_area"]
 
@@ -136,15 +136,10 @@ def group_areas(rows: list[dict[str, Any]], cell: tuple[float, float, float],
     >>> [r["kind"] for r in out], round(out[0]["area"], 4)
     (['area'], 0.0054)
     """
-    idx = [i for i, r in enumerate(rows) if r.get("kind") == "point"]
-    if len(idx) < MIN_COMPONENTS:
+    found = point_components(rows, cell, model, MIN_COMPONENTS)
+    if found is None:
         return rows
-    p = np.array([[rows[i]["x"], rows[i]["y"]] for i in idx], float)
-    amp = np.array([float(rows[i].get("amplitude_db", 0.0)) for i in idx])
-    z = float(np.median([rows[i]["range"] for i in idx]))
-    c = lateral_cell(model, z, cell)
-    if not np.isfinite(c) or c <= 0:
-        return rows
+    idx, p, amp, c = found
     areas, used = [], set()
     for group in _clusters(p, LINK_CELLS * c):
         if len(group) < MIN_COMPONENTS:

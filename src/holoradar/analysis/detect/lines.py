@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["group_lines", "lateral_cell"]
+__all__ = ["group_lines", "lateral_cell", "point_components"]
 
 END_DB = 13.5
 LINK_CELLS = 2.5
@@ -67,6 +67,22 @@ def lateral_cell(model: Any, z: float, fallback: tuple[float, ...]) -> float:
         return float(np.pi / min(mu, nu))
     finite = [float(v) for v in fallback[:2] if np.isfinite(v)]
     return max(finite) if finite else np.nan
+
+
+def point_components(rows: list[dict[str, Any]], cell: tuple[float, ...], model: Any,
+                     least: int) -> tuple[list[int], np.ndarray, np.ndarray, float] | None:
+    """The point rows CLEAN found, as the grouping rules take them: their indices in
+    ``rows``, lateral positions (n, 2), amplitudes (dB) and the lateral cell at their
+    median range; None with fewer than ``least`` points or no finite cell."""
+    idx = [i for i, r in enumerate(rows) if r.get("kind") == "point"]
+    if len(idx) < least:
+        return None
+    p = np.array([[rows[i]["x"], rows[i]["y"]] for i in idx], float)
+    amp = np.array([float(rows[i].get("amplitude_db", 0.0)) for i in idx])
+    c = lateral_cell(model, float(np.median([rows[i]["range"] for i in idx])), cell)
+    if not np.isfinite(c) or c <= 0:
+        return None
+    return idx, p, amp, c
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> float:
@@ -148,14 +164,10 @@ def group_lines(rows: list[dict[str, Any]], cell: tuple[float, float, float],
     >>> [r["kind"] for r in out], round(out[0]["length"], 3), round(out[0]["azimuth_deg"])
     (['line'], 0.12, 90)
     """
-    idx = [i for i, r in enumerate(rows) if r.get("kind") == "point"]
-    if len(idx) < MIN_COMPONENTS:
+    found = point_components(rows, cell, model, MIN_COMPONENTS)
+    if found is None:
         return rows
-    p = np.array([[rows[i]["x"], rows[i]["y"]] for i in idx], float)
-    z = float(np.median([rows[i]["range"] for i in idx]))
-    c = lateral_cell(model, z, cell)
-    if not np.isfinite(c) or c <= 0:
-        return rows
+    idx, p, _, c = found
     used: set[int] = set()
     chains: list[list[int]] = []
     for seed in range(len(idx)):            # strongest first

@@ -29,10 +29,10 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
+import numpy as np  # noqa: F401  (the examples use it)
 
 from .areas import _clusters
-from .lines import END_DB, LINK_CELLS, MIN_COMPONENTS, lateral_cell
+from .lines import END_DB, LINK_CELLS, MIN_COMPONENTS, point_components
 
 __all__ = ["absorb_ringing"]
 
@@ -52,15 +52,10 @@ def absorb_ringing(rows: list[dict[str, Any]], cell: tuple[float, float, float],
     >>> len(absorb_ringing(bar, (0.017, 0.017, np.inf)))
     9
     """
-    idx = [i for i, r in enumerate(rows) if r.get("kind") == "point"]
-    if len(idx) < 2:
+    found = point_components(rows, cell, model, 2)
+    if found is None:
         return rows
-    p = np.array([[rows[i]["x"], rows[i]["y"]] for i in idx], float)
-    amp = np.array([float(rows[i].get("amplitude_db", 0.0)) for i in idx])
-    z = float(np.median([rows[i]["range"] for i in idx]))
-    c = lateral_cell(model, z, cell)
-    if not np.isfinite(c) or c <= 0:
-        return rows
+    idx, p, amp, c = found
     ringing: set[int] = set()
     for group in _clusters(p, LINK_CELLS * c):
         top = max(amp[g] for g in group)
