@@ -6,6 +6,7 @@ that a user sees at once which input is wrong and what it should have been.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Sequence
 
@@ -89,6 +90,8 @@ def uniform_step(axis: np.ndarray, name: str, *, rtol: float = 1e-6) -> float:
 
 def check_nonnegative_ranges(z: object, name: str = "z") -> np.ndarray:
     """Return ranges ``z`` (metres, from the aperture) as a 1-D float array, refusing z < 0."""
+    if type(z) is float and 0.0 <= z < math.inf:   # one plane: the common call, fast
+        return np.array([z])
     arr = np.atleast_1d(np.asarray(z, dtype=float))
     if arr.ndim != 1 or arr.size == 0:
         raise ValueError(f"{name} must be a range in metres or a 1-D sequence of them")

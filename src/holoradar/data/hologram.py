@@ -9,6 +9,7 @@ so the paper's 16 x 16 array at 2.5 cm spans A = B = 40 cm.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -198,9 +199,12 @@ class Hologram:
         """Shape of ``data``."""
         return self.data.shape
 
-    @property
+    @cached_property
     def pitch(self) -> tuple[float, float]:
-        """``(dx, dy)`` in metres; raises if the grid is not uniform."""
+        """``(dx, dy)`` in metres; raises if the grid is not uniform.
+
+        Computed once (the axes are read-only), not at every migration.
+        """
         return uniform_step(self.x, "x"), uniform_step(self.y, "y")
 
     @property

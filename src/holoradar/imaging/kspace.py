@@ -315,6 +315,9 @@ def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.
                           np.where(q[:, None] != 0, My * dy / 2 / np.abs(q[:, None]), np.inf))
         j_band = np.floor((room - t0) / (rate * dz))
         j_band = np.where(evanescent, np.inf, np.nan_to_num(j_band, nan=np.inf, neginf=-1))
+        # A grazing component (kz = 0, e.g. the Nyquist column of a lambda/2 grid) has
+        # no finite travel: out of the band from the first plane on, as per plane.
+        j_band = np.where(np.isinf(t0) & ~evanescent, -1, j_band)
         mag = np.abs(a)
         floor = tiny * mag.max(initial=0.0)
         decay = np.abs(step)

@@ -9,6 +9,7 @@ paraxial Eq. 3 (through a medium: at the apparent distance).
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Sequence
@@ -23,7 +24,7 @@ from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn
 from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
 from ..physics.incident import incident_phasors
-from ..physics.medium import Medium
+from ..physics.medium import FREE_SPACE, Medium
 from ..physics.propagation import (
     DEFAULT_SNR_DB,
     AngularSpectrum,
@@ -245,7 +246,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         np.complex64 if hologram.data.dtype == np.complex64 else np.complex128)
     if work not in (np.complex64, np.complex128):
         raise ValueError(f"dtype must be numpy.complex64 or numpy.complex128, got {dtype!r}")
-    med = medium if medium is not None else Medium.free_space()
+    med = medium if medium is not None else FREE_SPACE
     stepping = algorithm != "frequency" and np.size(zs) > 1 and kspace.applicable(
         hologram, zs, med, method=method, fov=fov, combine="coherent",
         compensate_loss=compensate_loss, phase_incident=False)
@@ -283,7 +284,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     in_place = u == 1 and (My, Mx) == (ny, nx) and fov == "aperture"
     out = (None if in_place and zs.size == 1
            else np.empty((*batch, zs.size, oy, ox), dtype=work))
-    show = zs.size * oy * ox * max(1, int(np.prod(batch))) > 2e8 if progress is None \
+    show = zs.size * oy * ox * math.prod(batch) > 2e8 if progress is None \
         else progress
     # delay: a bar only for work that lasts (progress=True shows it after a second)
     bar = None
@@ -294,10 +295,12 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     chunk = zs.size if in_place else _CHUNK
     for c0 in range(0, zs.size, chunk):
         Ucs = op.adjoint_transfers[c0:c0 + chunk]
-        if in_place and zs.size == 1:
-            # One plane: multiply into the spectrum itself (ours, no longer needed),
-            # transform it in place and keep it as the image: no allocation.
-            prod = out = H[..., None, :, :]
+        if zs.size == 1:
+            # One plane: multiply into the spectrum itself (ours, no longer needed) and
+            # transform it in place; unpadded it is the image: no allocation.
+            prod = H[..., None, :, :]
+            if in_place:
+                out = prod
         else:
             prod = out[..., c0:c0 + len(Ucs), :, :] if in_place else np.empty(
                 (*batch, len(Ucs), My, Mx), dtype=work)
@@ -344,7 +347,7 @@ def _migrate_ground(hologram: Hologram, zs: np.ndarray, scalar: bool, medium: Me
     dx, dy = hologram.pitch
     warn_if_aliased(max(dx, dy), hologram.wavelength, "hologram",
                     round_trip=hologram.monostatic)
-    med = medium if medium is not None else Medium.free_space()
+    med = medium if medium is not None else FREE_SPACE
     gain = None
     if compensate_loss and not med.is_lossless:
         gain = (as_real(snr_db, "snr_db") if snr_db is not None
@@ -387,7 +390,7 @@ def _migrate_wideband(hologram: Hologram, z: Any, *, combine: str, equalize: Any
         raise ValueError(f"medium must be a holoradar.Medium or None, got {type(medium).__name__}")
     w = _weights(hologram, equalize)
     zs_all = check_nonnegative_ranges(z, "z")
-    med = medium if medium is not None else Medium.free_space()
+    med = medium if medium is not None else FREE_SPACE
     comp = kw.get("compensate_loss", True)
     method, fov = kw.get("method", "angular"), kw.get("fov", "aperture")
     fast = kw.get("frame") != "ground" and hologram.pose.is_identity and kspace.applicable(
@@ -591,7 +594,7 @@ def check_fits(hologram: Hologram, planes: int, upsample: Any, dtype: Any, *,
     ny, nx = hologram.data.shape[-2:]
     lead = hologram.data.shape[:-3] if hologram.is_wideband else hologram.data.shape[:-2]
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    size = int(np.prod(lead, dtype=np.int64)) * planes * oy * ox * work.itemsize
+    size = math.prod(lead) * planes * oy * ox * work.itemsize
     if factor * size < _CHECK_ABOVE:
         return   # asking the system (~0.1-0.3 ms) would cost a small plane 5-10%
     avail = available_memory()

@@ -745,3 +745,8 @@ class Medium:
     def optical_path(self, z: float) -> complex:
         """Normal-incidence optical path ``sum n_j h_j`` from the aperture to ``z`` (metres)."""
         return complex(sum(self.n(m) * h for m, h in self.crossings(z)))
+
+
+#: Air everywhere, shared (a Medium is immutable): what a function with ``medium=None``
+#: works in, without building a new one at every call.
+FREE_SPACE: Medium = Medium()
