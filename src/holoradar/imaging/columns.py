@@ -48,6 +48,7 @@ __all__ = ["available", "migrate_columns", "output_bytes", "warm"]
 
 _COLS = 256          # components per block of the compiled loop (its terms stay in cache)
 _THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
+_GATHER_BYTES = 1 << 24  # padded spectra of a group of frequencies transformed together
 _BUFFER_SHARE = 0.5  # inverse-FFT buffers at most this share of the output volume,
 _BUFFER_MIN = 1 << 24  # or 16 MiB
 # A term whose weight fell below this fraction of its frequency's largest is dropped:
@@ -70,21 +71,22 @@ def _kernel() -> Any:
     import numba
 
     def column_sum(ar, ai, sr, si, jm, bend, pos, order, n, j0, j1, zero, outv):
-        # Block-major (nblocks, nf, L): ar, ai each term's value at plane j0 (updated in
-        # place to j1); sr, si its step; jm its last plane; bend (nblocks,) the last
+        # ar, ai (nf, nblocks, L): each term's value at plane j0 (updated in place to
+        # j1); block-major (nblocks, nf, L): sr, si its step; jm its last plane; bend
+        # (nblocks,) the last
         # plane of any term of a block; pos (nblocks, L) where component b * L + c goes
         # in a plane of outv (real part at 2 pos, imaginary at 2 pos + 1), which holds
         # zeros on entry; order: the blocks to do (a thread's share);
         # n components. Four planes per pass over a block's terms (the terms are read
         # and written once for four multiply-adds), then one plane at a time.
-        nf, L = ar.shape[1:]
+        nf, L = ar.shape[0], ar.shape[2]
         for t in range(order.size):
             b = order[t]
             if bend[b] < j0:
                 continue
             m = min(L, n - b * L)
             p = pos[b]
-            a_r, a_i, s_r, s_i, j_m = ar[b], ai[b], sr[b], si[b], jm[b]
+            s_r, s_i, j_m = sr[b], si[b], jm[b]
             acc = np.empty((8, L), ar.dtype)
             stop = min(j1, bend[b] + 1)
             j = j0
@@ -96,7 +98,7 @@ def _kernel() -> Any:
                 a0r, a0i, a1r, a1i = acc[0], acc[1], acc[2], acc[3]
                 a2r, a2i, a3r, a3i = acc[4], acc[5], acc[6], acc[7]
                 for f in range(nf):
-                    xr_, xi_, sr_, si_, jm_ = a_r[f], a_i[f], s_r[f], s_i[f], j_m[f]
+                    xr_, xi_, sr_, si_, jm_ = ar[f, b], ai[f, b], s_r[f], s_i[f], j_m[f]
                     if k == 4:
                         for c in range(L):
                             xr = xr_[c]
@@ -300,7 +302,9 @@ class ColumnPlan:
 
     grid: tuple[int, int]
     live: np.ndarray   # (n,) flat indices into the padded grid, deepest-reaching first
-    gain: np.ndarray   # (nf, n) conj transfer to the first plane (work dtype)
+    gain: np.ndarray   # (nf, nblocks * _COLS) conj transfer to the first plane (work
+    #                    dtype), 0 past n and where a term is never used
+    src: np.ndarray    # (nblocks * _COLS,) live, then 0 up to a whole block (gain 0)
     sr: np.ndarray     # (nf, n) step, real part
     si: np.ndarray     # (nf, n) step, imaginary part
     jm: np.ndarray     # (nf, n) int32 last plane (-1: never)
@@ -317,7 +321,8 @@ class ColumnPlan:
 
     @property
     def nbytes(self) -> int:
-        return sum(a.nbytes for a in (self.live, self.gain, self.sr, self.si, self.jm,
+        return sum(a.nbytes for a in (self.live, self.gain, self.src, self.sr, self.si,
+                                      self.jm,
                                       self.bend, self.rows, self.row_reach, self.pos))
 
     @classmethod
@@ -335,9 +340,11 @@ class ColumnPlan:
         n = live.size
         nb = max(1, -(-n // _COLS))
         q_idx = unfold[live]
-        gain = gain_q[:, q_idx]
         jm = jmax[:, live]
-        gain[jm < 0] = 0
+        gain = np.zeros((len(ks), nb * _COLS), dtype=work)
+        gain[:, :n] = np.where(jm < 0, 0, gain_q[:, q_idx])
+        src = np.zeros(nb * _COLS, dtype=np.intp)
+        src[:n] = live
         real = np.float32 if work == np.complex64 else np.float64
 
         def blocked(values: np.ndarray, fill: Any, dtype: Any) -> np.ndarray:
@@ -359,36 +366,49 @@ class ColumnPlan:
         rank[used_rows] = np.arange(used_rows.size)
         pos = np.zeros(nb * _COLS, dtype=np.int64)
         pos[:n] = live if direct else rank[rows] * Mx + live % Mx
-        plan = cls(grid, live, gain, blocked(step.real, 0, real), blocked(step.imag, 0, real),
+        plan = cls(grid, live, gain, src, blocked(step.real, 0, real), blocked(step.imag, 0, real),
                    blocked(jm, -1, np.int32), bend, used_rows, row_reach[used_rows],
                    pos.reshape(nb, _COLS), direct)
-        for arr in (plan.live, plan.gain, plan.sr, plan.si, plan.jm, plan.bend, plan.rows,
-                    plan.row_reach, plan.pos):
+        for arr in (plan.live, plan.gain, plan.src, plan.sr, plan.si, plan.jm, plan.bend,
+                    plan.rows, plan.row_reach, plan.pos):
             arr.setflags(write=False)
         return plan
 
     def gather(self, data: np.ndarray, weights: np.ndarray, work: np.dtype, workers: int
                ) -> tuple[np.ndarray, np.ndarray]:
         """The live components of ``data`` (nf, ny, nx), weighted and taken to the first
-        plane: real and imaginary parts, each (nblocks, nf, _COLS), ready for the
+        plane: real and imaginary parts, each (nf, nblocks, _COLS), ready for the
         compiled loop.
 
-        One frequency at a time: a pruned forward FFT on the padded grid (along x over
-        the recorded rows, then along y).
+        Frequencies in groups of about ``_GATHER_BYTES`` of padded spectra: each group's
+        pruned forward FFTs run in place in one zero-padded array (along x over the
+        recorded rows, then along y), then its live components are taken, weighted and
+        split into real and imaginary parts, frequency-major as the loop reads them.
         """
         My, Mx = self.grid
-        n = self.live.size
+        ny, nx = data.shape[-2:]
         real = np.float32 if work == np.complex64 else np.float64
-        nb = self.sr.shape[0]
-        ar = np.empty(self.sr.shape, dtype=real)
+        nf, (nb, L) = self.nf, self.sr.shape[::2]
+        ar = np.empty((nf, nb, L), dtype=real)
         ai = np.empty_like(ar)
-        v = np.zeros(nb * _COLS, dtype=work)
-        for i in range(self.nf):
-            H = sfft.fft(data[i].astype(work, copy=False), n=Mx, axis=-1, workers=workers)
-            H = sfft.fft(H, n=My, axis=-2, workers=workers, overwrite_x=True)
-            np.take(H.reshape(-1), self.live, out=v[:n])
-            v[:n] *= self.gain[i]
-            v[:n] *= work.type(weights[i])
-            ar[:, i] = v.real.reshape(nb, _COLS)
-            ai[:, i] = v.imag.reshape(nb, _COLS)
+        group = int(max(1, min(nf, _GATHER_BYTES // (My * Mx * work.itemsize))))
+        spec = np.empty((group, My, Mx), dtype=work)
+        terms = np.empty((group, nb * L), dtype=work)
+        w = np.asarray(weights, dtype=float)
+        for f0 in range(0, nf, group):
+            g = min(group, nf - f0)
+            sp, te = spec[:g], terms[:g]
+            if (My, Mx) != (ny, nx):
+                sp.fill(0)
+            sp[:, :ny, :nx] = data[f0:f0 + g]
+            rows = sfft.fft(sp[:, :ny], axis=-1, workers=workers, overwrite_x=True)
+            if not np.may_share_memory(rows, sp):   # overwrite_x is a hint
+                sp[:, :ny] = rows
+            full = sfft.fft(sp, axis=-2, workers=workers, overwrite_x=True)
+            np.take(full.reshape(g, -1), self.src, axis=1, out=te)
+            te *= self.gain[f0:f0 + g]
+            if np.any(w[f0:f0 + g] != 1):
+                te *= w[f0:f0 + g, None].astype(work)
+            ar[f0:f0 + g] = te.real.reshape(g, nb, L)
+            ai[f0:f0 + g] = te.imag.reshape(g, nb, L)
         return ar, ai
