@@ -229,6 +229,24 @@ def test_output_is_never_destroyed(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["h.nc"]
 
 
+def test_an_output_that_is_an_input_by_any_name_is_refused(tmp_path):
+    # An input is recognised by file identity: the same path written differently, a
+    # symbolic link to it and a hard link to it are all the input; a new path is not.
+    from holoradar.io.output import check_output
+
+    src = hr.save(HOLOGRAMS["single"], tmp_path / "h.nc")
+    (tmp_path / "sub").mkdir()
+    os.symlink(src, tmp_path / "soft.nc")
+    os.link(src, tmp_path / "hard.nc")
+    for alias in (src, tmp_path / "sub" / ".." / "h.nc", tmp_path / "soft.nc",
+                  tmp_path / "hard.nc"):
+        with pytest.raises(ValueError, match="one of the inputs"):
+            check_output(alias, suffixes=[".nc"], inputs=[src], overwrite=True)
+    assert check_output(tmp_path / "new.nc", suffixes=[".nc"], inputs=[src]).name == "new.nc"
+    other = hr.save(HOLOGRAMS["single"], tmp_path / "other.nc")
+    assert check_output(other, suffixes=[".nc"], inputs=[src], overwrite=True) == other
+
+
 def test_files_get_the_users_umask(tmp_path):
     old = os.umask(0o027)
     try:

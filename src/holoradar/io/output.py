@@ -64,12 +64,11 @@ def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
     if not any(target.name.lower().endswith(s) for s in allowed):
         raise ValueError(f"{name} must end in {' or '.join(allowed)} for this format, got "
                          f"{target.name!r}")
-    for src in inputs:
-        try:
-            same = Path(src).resolve() == target.resolve()
-        except OSError:
-            same = False
-        if same:
+    # An input exists: a target that does not cannot be one (no path to resolve per input:
+    # a survey passes thousands). One that does is compared by file identity.
+    here = _identity(target)
+    for src in inputs if here is not None else ():
+        if _identity(src) == here:
             raise ValueError(f"{name} {str(target)!r} is one of the inputs: refusing to replace "
                              "the data it was computed from")
     if not target.parent.is_dir():
@@ -100,3 +99,12 @@ def write_via_temp(target: Path, write: Callable[[Path], None]) -> Path:
         tmp_path.unlink(missing_ok=True)
         raise
     return target
+
+
+def _identity(path: str | os.PathLike[str]) -> tuple[int, int] | None:
+    """``(device, inode)`` of an existing path (links followed), else None."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return st.st_dev, st.st_ino

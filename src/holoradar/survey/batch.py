@@ -223,7 +223,9 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         raise ValueError("frames: no frames given")
     target = check_output(store, suffixes=[".zarr"], inputs=given, overwrite=True, name="store",
                           folder=True)
-    inside = [p for p in given if target.resolve() in p.resolve().parents]
+    # A frame inside the store's folder: only where that folder exists already.
+    root = target.resolve() if target.exists() else None
+    inside = [p for p in given if root is not None and root in p.resolve().parents]
     if inside:
         raise ValueError(f"store {str(target)!r} holds the frame {str(inside[0])!r}: refusing "
                          "to write into (or replace) the folder of the data")
