@@ -278,7 +278,7 @@ def test_killed_process_leaves_readable_store(survey_frames, tmp_path: Path) -> 
 def test_images_are_compressed_and_plain_stores_still_work(survey_frames, tmp_path: Path,
                                                             monkeypatch: pytest.MonkeyPatch
                                                             ) -> None:
-    """New stores compress the images (Blosc LZ4, shuffled); a store written before
+    """New stores compress the images (Blosc LZ4, bit-shuffled); a store written before
     (plain chunks) is read and resumed as it is, exactly."""
     import zarr
 
@@ -287,7 +287,7 @@ def test_images_are_compressed_and_plain_stores_still_work(survey_frames, tmp_pa
     hr.survey.run_batch(paths[:3], new, z=Z, scheduler="synchronous")
     codecs = zarr.open_array(str(new / "image"), mode="r").compressors
     assert [(type(c).__name__, c.cname.value, c.shuffle.value) for c in codecs] == \
-        [("BloscCodec", "lz4", "shuffle")]
+        [("BloscCodec", "lz4", "bitshuffle")]
     assert hr.survey.describe_store(new)["compressors"] == ["blosc"]
     assert _assert_exact(new, paths, holos).all()
 
@@ -302,6 +302,20 @@ def test_images_are_compressed_and_plain_stores_still_work(survey_frames, tmp_pa
     assert hr.survey.describe_store(old)["compressors"] == []
     np.testing.assert_array_equal(hr.survey.frame_image(old, 4).data,
                                   hr.migrate(holos[4], Z).data)
+
+    # A store of the version that shuffled bytes keeps its codec when resumed.
+    from zarr.codecs import BloscCodec
+
+    byte = tmp_path / "byte.zarr"
+    monkeypatch.setattr(survey_store, "_image_codecs",
+                        lambda: [BloscCodec(cname="lz4", clevel=5, shuffle="shuffle")])
+    hr.survey.run_batch(paths[:3], byte, z=Z, scheduler="synchronous")
+    monkeypatch.undo()
+    s = hr.survey.run_batch(paths[:6], byte, z=Z, scheduler="synchronous")
+    assert (s["resumed"], s["done"]) == (3, 3)
+    assert [c.shuffle.value for c in zarr.open_array(str(byte / "image"), mode="r").compressors
+            ] == ["shuffle"]
+    assert _assert_exact(byte, paths, holos).all()
 
 
 def test_size_is_said_before_and_a_full_disk_refused(survey_frames, tmp_path: Path,

@@ -178,7 +178,7 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
 
     Notes
     -----
-    The store's images are compressed (Blosc LZ4 after a byte shuffle), which
+    The store's images are compressed (Blosc LZ4 after a bit shuffle), which
     saves only about a tenth: float images are noise in their low bits. Each
     frame takes ``nz * ny' * nx' * 2 * 8`` bytes before compression (4 for
     complex64 frames), ``ny' = upsample * (ny - 1) + 1``: 240 frames of 16 x 16

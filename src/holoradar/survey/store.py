@@ -5,7 +5,7 @@ Layout (``survey.zarr``; dimensions named, so ``xarray.open_zarr`` reads it)::
     image       (frame, z, y, x, iq)  float64 (float32 for complex64 frames); I = iq 0,
                                       Q = iq 1; chunks of several frames (up to
                                       16 MiB, :func:`frames_per_chunk`), compressed
-                                      (Blosc LZ4, byte shuffle); NaN until written
+                                      (Blosc LZ4, bit shuffle); NaN until written
     z           (z,)     ranges of the planes from the aperture, m
     y, x        (y,) (x,)  pixel offsets from the frame's centre, m (the same for all)
     position    (frame, xyz)  world position (x, y, z) of the frame's centre, m
@@ -97,18 +97,19 @@ def frames_per_chunk(per_frame: int, n_frames: int) -> int:
 
 
 def _image_codecs() -> list[Any]:
-    """The image's compressor: Blosc's LZ4 after a byte shuffle.
+    """The image's compressor: Blosc's LZ4 after a bit shuffle.
 
-    Images are float noise in their low mantissa bytes, so no codec takes them far:
-    on a 61-plane frame upsampled 8 times (14.3 MB) the shuffle and LZ4 keep 88.5%
-    of the bytes at about the speed of plain chunks (20 to 30 ms a frame), where
-    Zarr's default (Zstandard, no shuffle) keeps 95.5% at four times the time; the
-    shuffle groups the exponent and high mantissa bytes, which repeat across a
-    smooth (band-limited) image.
+    Images are float noise in their low mantissa bits, so no codec takes them far.
+    The shuffle groups the sign, exponent and high mantissa bits, which repeat across
+    a smooth (band-limited) image. Measured on a 61-plane frame of a 16 x 16 array
+    upsampled 8 times (14.3 MB, float64): the bit shuffle and LZ4 keep 89.4% of the
+    bytes in 31 ms a frame, a byte shuffle 90.1% in 38 ms, plain chunks take 18 ms;
+    on 9 planes of 128 x 128 (2.4 MB) 90.8% in 5.5 ms against 93.4% in 7.8 ms (plain
+    4.0 ms); Zarr's default (Zstandard, no shuffle) kept 95.5% at four times the time.
     """
     from zarr.codecs import BloscCodec
 
-    return [BloscCodec(cname="lz4", clevel=5, shuffle="shuffle")]
+    return [BloscCodec(cname="lz4", clevel=5, shuffle="bitshuffle")]
 
 
 def is_survey(path: Path) -> bool:
