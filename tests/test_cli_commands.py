@@ -432,8 +432,11 @@ def test_unit_slips_in_options_are_refused_before_any_work(holo_nc, tmp_path, mo
               "-o", out)
     assert ("warning: every plane of --z (0.1..0.25 m) lies above the ground surface at "
             "0.3 m") in res.output
-    # --no-check takes a range as given.
-    run("image", holo_nc, "--z", "42", "-o", tmp_path / "far.nc", "--no-png", "--no-check")
+    # --no-check takes a range as given (6 m, refused above; 42 m would image on a
+    # 2048 x 2048 grid, the padding that samples the transfer function that far: 3 s).
+    one_line_error(run("image", holo_nc, "--z", "6", "-o", tmp_path / "far.nc", ok=False),
+                   "--z", "6 m in front of a 0.4 m array")
+    run("image", holo_nc, "--z", "6", "-o", tmp_path / "far.nc", "--no-png", "--no-check")
     # plot labels depths with --z-surface: 30 for 30 cm is refused, beyond the planes warned
     one_line_error(run("plot", out, "-o", tmp_path / "p.png", "--z-surface", "30", ok=False),
                    "--z-surface 0.3")
