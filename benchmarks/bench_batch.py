@@ -14,8 +14,15 @@ round (a shared machine's other load then weighs on all alike; medians of
 * ``batch1``: ``run_batch(..., workers=1)`` into a fresh store (this process);
 * ``batch2``: ``run_batch(..., workers=2)``, the local cluster started for the run
   and closed after it, as ``holoradar batch --workers 2`` does: its start counts;
-* ``batch2_warm``: on a ``LocalCluster`` of 2 workers started before the clock
-  (its address as ``scheduler``): the steady throughput of two workers.
+* ``batch2_warm``: on the local cluster ``--workers 2`` starts (one thread a worker),
+  started before the clock (its address as ``scheduler``): the steady throughput of
+  two workers.
+
+Then, the ceiling two workers can reach on this machine: the plain loop in two
+fresh processes side by side (one thread each, half the frames each, timed inside
+each after three warm-up frames), against the same loop in one such process
+(``loop_one_process``, ``loop_two_processes``; ratio 0.5 where two cores give twice
+the throughput).
 
 Then cold, once each, in fresh Python processes (imports, first FFTs and the
 cluster's start count): the loop, ``workers=1`` and ``workers=2``.
@@ -104,6 +111,43 @@ def cold(mode: str, paths: list[Path], work: Path, planes: int, upsample: int) -
     return float(out.stdout.strip().splitlines()[-1])
 
 
+_LOOP = """
+import sys, time
+import numpy as np
+import holoradar as hr
+paths = open(sys.argv[1]).read().split()
+a, b, up, planes = map(int, sys.argv[2:6])
+z = list(np.linspace(0.2, 0.4, planes))
+for p in paths[:3]:
+    hr.migrate(hr.load(p), z, upsample=up)
+t0 = time.perf_counter()
+for p in paths[a:b]:
+    hr.migrate(hr.load(p), z, upsample=up)
+print(time.perf_counter() - t0)
+"""
+
+
+def two_processes(paths: list[Path], work: Path, planes: int, upsample: int
+                  ) -> tuple[float, float]:
+    """ms per frame of the plain loop in one fresh one-thread process, and in two side
+    by side on half the frames each (the slower of the two), imports excluded."""
+    listing = work / "loop_frames.txt"
+    listing.write_text("\n".join(map(str, paths)))
+    env = {**os.environ, "HOLORADAR_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+           "OMP_NUM_THREADS": "1"}
+
+    def start(a: int, b: int) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, "-c", _LOOP, str(listing), str(a), str(b),
+                                 str(upsample), str(planes)], stdout=subprocess.PIPE,
+                                text=True, env=env)
+
+    n = len(paths)
+    one = float(start(0, n).communicate()[0])
+    procs = [start(0, n // 2), start(n // 2, n)]
+    two = max(float(p.communicate()[0]) for p in procs)
+    return 1e3 * one / n, 1e3 * two / n
+
+
 def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
     n, size, planes, up = case["frames"], case["size"], case["planes"], case["upsample"]
     paths, holos = make_frames(work / f"f{size}", n, size)
@@ -156,6 +200,10 @@ def run_case(case: dict, work: Path, repeat: int, cluster_address: str) -> dict:
            "ratio_to_loop": {c: med[c] / med["loop"] for c in ("batch1", "batch2",
                                                                "batch2_warm")},
            "loadavg_1min": load}
+    tries = [two_processes(paths, work, planes, up) for _ in range(2)]
+    res["loop_one_process_ms"] = float(np.median([t[0] for t in tries]))
+    res["loop_two_processes_ms"] = float(np.median([t[1] for t in tries]))
+    res["two_processes_ratio"] = res["loop_two_processes_ms"] / res["loop_one_process_ms"]
     res["cold_s"] = {m: cold(m, paths, work, planes, up) for m in ("loop", "1", "2")}
     res["cold_ratio_to_loop"] = {m: res["cold_s"][m] / res["cold_s"]["loop"]
                                  for m in ("1", "2")}
@@ -168,7 +216,7 @@ def main() -> dict:
     ap.add_argument("--quick", action="store_true", help="2 rounds, a quarter of the frames")
     ap.add_argument("--out", default=str(Path(__file__).with_name("results_batch.json")))
     args = ap.parse_args()
-    from distributed import LocalCluster
+    from holoradar.survey.schedule import local_cluster
 
     repeat = 2 if args.quick else REPEAT
     cases = [{**c, "frames": c["frames"] // 4} for c in CASES] if args.quick else CASES
@@ -179,9 +227,11 @@ def main() -> dict:
                  "repeat": repeat, "note": "medians of interleaved rounds; the machine is "
                  "shared with other jobs (loadavg_1min: before, after each round, after "
                  "the cold runs)", "cases": []}
+    # The cluster `--workers 2` starts (one thread a worker, glibc's memory handling),
+    # started before the clock.
+    cluster, client = local_cluster(2)
     try:
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=":0") as cluster:
+        with cluster, client:
             for case in cases:
                 r = run_case(case, work, repeat, cluster.scheduler_address)
                 res["cases"].append(r)
@@ -193,6 +243,9 @@ def main() -> dict:
                     ratio = r["ratio_to_loop"].get(c)
                     print(f"  {c:12s} {ms[c]:7.2f} ms/frame"
                           + (f"   {ratio:.2f} x loop" if ratio else ""))
+                print(f"  plain loop, one process {r['loop_one_process_ms']:.2f}, two side by "
+                      f"side {r['loop_two_processes_ms']:.2f} ms/frame "
+                      f"({r['two_processes_ratio']:.2f})")
                 print("  cold (fresh process): " + ", ".join(
                     f"{m} {v:.2f} s" for m, v in r["cold_s"].items()))
     finally:
