@@ -347,7 +347,7 @@ return out;
 """
 
 
-def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, tmp_path):
+def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, browser, tmp_path):
     # At 1000 x 800 the controls, the plan view and both sections stand side by side,
     # none cut off; before the document arrives the page says it is loading, so a plain
     # headless screenshot (taken at the page's load) is not blank.
@@ -356,7 +356,7 @@ def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, tmp_path):
     from matplotlib.image import imread
 
     path, _, _ = rod
-    driver = headless_chromium(1000, 800)
+    driver = browser   # the module's browser, its viewport set to 1000 x 800 here
     try:
         # The viewport itself 1000 x 800 (a window's size includes the browser's frame).
         driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride", {
@@ -384,7 +384,7 @@ def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, tmp_path):
             pixels = imread(plain)[..., :3]
             assert (pixels.min(axis=-1) < 0.5).sum() > 200, "a blank page"
     finally:
-        driver.quit()
+        driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
 
 
 _ROWS_JS = """
