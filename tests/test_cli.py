@@ -128,7 +128,7 @@ def test_image_command_reads_and_writes_netcdf_and_never_destroys_data(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["holo.nc", "img.nc", "img.png"]
 
 
-def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch):
+def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch, tmp_path):
     """The third panel's title ran off the figure ('... to L = 37.6 c'); the glare figure
     wrote z_m = 2 z0 - z_s without saying what z0 and z_s are."""
     from holoradar.app import demo, plotting
@@ -141,7 +141,7 @@ def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch):
         return real(fig, *args, **kwargs)
 
     monkeypatch.setattr(plotting, "to_png", keep)
-    demo.run_demo(None, upsample=1)
+    demo.run_demo(tmp_path / "demo", upsample=1)
     assert len(figs) == 5
     for fig in figs:
         renderer = fig.canvas.get_renderer()

@@ -39,7 +39,8 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
     Parameters
     ----------
     out : path or None
-        Output folder (created if missing). ``None`` computes without writing.
+        Output folder (created if missing). ``None`` computes the summary only (no
+        figures drawn, nothing written).
     upsample : int
         Image pixels per element pitch.
     overwrite : bool
@@ -142,6 +143,8 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
         "run_time_s": {"simulate": t_sim, "migrate": t_img,
                        "total": time.perf_counter() - t0},
     }
+    if out is None:   # the summary only: drawing the five figures is most of the time
+        return summary
     outline = (tg.x, tg.y, tg.reflectivity.real != 0)
     figs = {
         "hologram.png": plotting.plot_hologram(holo, "Simulated hologram"),
@@ -167,17 +170,16 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
             title="Letter R spectrum |F(p, q)|, 16 x 16 array's window"),
     }
     pngs = {name: plotting.to_png(fig) for name, fig in figs.items()}
-    if out is not None:
-        outdir = Path(out)
-        outdir.mkdir(parents=True, exist_ok=True)
-        for name, payload in pngs.items():
-            write_atomic(outdir / name, payload)
-        # The hologram too, so that `holoradar image demo_out/hologram.nc ...` works.
-        from ..io import save
+    outdir = Path(out)
+    outdir.mkdir(parents=True, exist_ok=True)
+    for name, payload in pngs.items():
+        write_atomic(outdir / name, payload)
+    # The hologram too, so that `holoradar image demo_out/hologram.nc ...` works.
+    from ..io import save
 
-        save(holo, outdir / "hologram.nc", overwrite=True,
-             history=[{"step": "simulate", "parameters": {"scene": "demo: letter R in sand"}}])
-        summary["files"] = sorted([*pngs, "hologram.nc", "summary.json"])
-        assert set(summary["files"]) == set(FILES), "FILES lists what the demo writes"
-        write_atomic(outdir / "summary.json", json.dumps(summary, indent=2).encode())
+    save(holo, outdir / "hologram.nc", overwrite=True,
+         history=[{"step": "simulate", "parameters": {"scene": "demo: letter R in sand"}}])
+    summary["files"] = sorted([*pngs, "hologram.nc", "summary.json"])
+    assert set(summary["files"]) == set(FILES), "FILES lists what the demo writes"
+    write_atomic(outdir / "summary.json", json.dumps(summary, indent=2).encode())
     return summary
