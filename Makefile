@@ -37,11 +37,13 @@ browser:
 # set-up is made once), each worker's BLAS on one thread: two suites' worth of BLAS
 # threads on two cores would only wait on each other.
 PYTEST_PARALLEL := -n auto --dist loadfile
-# Compiled bytecode of src and tests kept in .cache/pycache (out of the tree, even where
-# the environment turns bytecode off), made once before the workers start: otherwise
-# each of them compiles every module again (~4.5 s of collection each). And numba's
-# loop checked (rebuilt if its source changed) so that no worker compiles it.
-PYCACHE := PYTHONDONTWRITEBYTECODE= PYTHONPYCACHEPREFIX=$(CURDIR)/.cache/pycache
+# Compiled bytecode of src and tests kept (in their __pycache__ folders, ignored by git),
+# even where the environment turns bytecode off, and made once before the workers
+# start: otherwise each of them compiles every module again (~4.5 s of collection
+# each). (Not PYTHONPYCACHEPREFIX: under it Python reads no __pycache__ folder, and
+# recompiled every installed package it imports, numpy to bokeh, in every worker.)
+# And numba's loop checked (rebuilt if its source changed) so that no worker compiles it.
+PYCACHE := PYTHONDONTWRITEBYTECODE=
 PREPARE := $(PYCACHE) $(BIN)/python -m compileall -q -j 0 src tests && \
 	$(PYCACHE) $(BIN)/python -c "from holoradar.imaging import columns; columns.warm()"
 test: $(STAMP) browser
