@@ -88,6 +88,24 @@ def test_auto_takes_the_compiled_loop_and_the_numpy_sum_without_numba(monkeypatc
     assert _rel(a.data, b.data) < 10 * ZS.size * EPS[np.complex128]
 
 
+def test_warm_builds_every_loop_a_migration_calls(monkeypatch):
+    # warm() is what `make` runs at install so that no user's first call compiles: the
+    # loops it builds must be the ones migrate calls (a plan's arrays are read-only,
+    # which numba types apart: warm() built writable ones, and a fresh install compiled
+    # at its first wideband call). A new dispatcher (on numba's disk cache) sees only
+    # what warm() and then the migrations ask of it.
+    fresh = columns._kernel.__wrapped__()
+    monkeypatch.setattr(columns, "_kernel", lambda: fresh)
+    columns.warm()
+    built = set(fresh.signatures)
+    assert len(built) == 2
+    for dtype in (np.complex64, np.complex128):
+        h = _hologram(True, None, False, dtype)
+        for pad in (False, True):
+            hr.migrate(h, ZS, pad=pad)
+    assert set(fresh.signatures) == built
+
+
 def test_auto_falls_back_to_the_per_frequency_sum_where_the_phase_shift_cannot():
     # Planes not uniform, or a lossy ground to compensate: "auto" silently sums
     # frequency by frequency (the same code path as "frequency", bit for bit).

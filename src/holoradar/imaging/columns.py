@@ -163,10 +163,16 @@ def warm() -> None:
     first compilation takes seconds, loading it later a fraction of one).
     """
     kernel = _kernel()
+
+    def frozen(a: np.ndarray) -> np.ndarray:
+        a.setflags(write=False)   # as a ColumnPlan's arrays are: numba types them apart
+        return a
+
     for real in (np.float32, np.float64):
         z = np.zeros((1, 1, _COLS), dtype=real)
-        kernel(z, z.copy(), z.copy(), z.copy(), np.zeros((1, 1, _COLS), np.int32),
-               np.zeros(1, np.int32), np.zeros((1, _COLS), np.int64), np.zeros(1, np.int64),
+        kernel(z, z.copy(), frozen(z.copy()), frozen(z.copy()),
+               frozen(np.zeros((1, 1, _COLS), np.int32)), frozen(np.zeros(1, np.int32)),
+               frozen(np.zeros((1, _COLS), np.int64)), np.zeros(1, np.int64),
                0, 0, 1, real(0), np.zeros((1, 2), dtype=real))
 
 
