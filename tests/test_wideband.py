@@ -234,3 +234,25 @@ def test_one_frequency_phase_step_equals_plane_by_plane(monostatic, medium):
     b = hr.migrate(h, zs, medium=medium, upsample=2, algorithm="frequency")
     assert a.data.shape == b.data.shape == (2, 16, 47, 47)
     assert np.linalg.norm(a.data - b.data) < 1e-10 * np.linalg.norm(b.data)
+
+
+@pytest.mark.parametrize("medium", [None, hr.Medium.half_space(0.2, 2.5 + 0.1j)])
+def test_normal_plane_wave_phasor_is_one_pixel_broadcast_exactly(medium):
+    # A normal plane wave's incident phase is the same across a plane (its lateral
+    # factor is exactly 1), so the frequencies' sum takes it on one pixel per plane
+    # and broadcasts it: it must equal the phasor computed at every pixel, bit for bit.
+    from holoradar.imaging.migrate import _incident_phasor
+    from holoradar.physics.incident import incident_phasors
+
+    med = medium if medium is not None else hr.Medium.free_space()
+    x = np.linspace(-0.2, 0.2, 21)
+    img = hr.Image(np.zeros((3, 21, 21), complex), x, x, np.array([0.1, 0.25, 0.4]), 9.9e9,
+                   "angular", has_z_axis=True)
+    k = 2 * np.pi * 9.9e9 / hr.C0
+    got = _incident_phasor(None, k, med, img)
+    full = incident_phasors([hr.PlaneWave()], k, med, img.x, img.y, img.z)[0]
+    assert got.shape == full.shape
+    np.testing.assert_array_equal(got, full)
+    # a tilted wave is not uniform: computed at every pixel
+    tilted = _incident_phasor(hr.PlaneWave(0.2, 0.0), k, med, img)
+    assert not np.allclose(tilted[0], tilted[0, 0, 0])

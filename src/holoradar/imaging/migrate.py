@@ -480,6 +480,11 @@ def _incident_phasor(source: Any, k: float, medium: Medium, img: Image,
         X, Y = np.meshgrid(img.x, img.y)
         pts = (pose.to_world(X, Y)[None] + img.z[:, None, None, None] * pose.normal)
         e0 = src.field(k, medium, pts.reshape(-1, 3)).reshape(pts.shape[:-1])
+    elif isinstance(src, PlaneWave) and src.alpha == 0.0 and src.beta == 0.0:
+        # At normal incidence the wave is the same across every plane (its lateral
+        # factor is exactly 1): one pixel per plane, broadcast (read-only).
+        one = incident_phasors([src], k, medium, img.x[:1], img.y[:1], img.z)[0]
+        return np.broadcast_to(one, (img.z.size, img.y.size, img.x.size))
     else:
         return incident_phasors([src], k, medium, img.x, img.y, img.z)[0]
     mag = np.abs(e0)
