@@ -354,44 +354,48 @@ return out;
 """
 
 
-def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod, browser, tmp_path):
+def test_page_fits_a_1000_by_800_window_and_says_it_is_loading(rod_page, tmp_path):
     # At 1000 x 800 the controls, the plan view and both sections stand side by side,
     # none cut off; before the document arrives the page says it is loading, so a plain
-    # headless screenshot (taken at the page's load) is not blank.
+    # headless screenshot (taken at the page's load) is not blank. The module's viewer
+    # and browser, a new page of it at that viewport.
     import subprocess
 
     from matplotlib.image import imread
 
-    path, _, _ = rod
-    driver = browser   # the module's browser, its viewport set to 1000 x 800 here
+    driver, server, _ = rod_page
     try:
+        driver.get("about:blank")   # the old page's closed websocket is not this one's error
+        driver.get_log("browser")
         # The viewport itself 1000 x 800 (a window's size includes the browser's frame).
         driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride", {
             "width": 1000, "height": 800, "deviceScaleFactor": 1, "mobile": False})
-        with _page(driver, [path, "--eps", "2.5", "--sigma", str(SIGMA), "--z-surface",
-                            "0.30", "--glare", "off"]) as server:
-            scroll_w, inner_w = driver.execute_script(
-                "return [document.documentElement.scrollWidth, window.innerWidth]")
-            assert inner_w == 1000 and scroll_w <= inner_w  # nothing beyond the right edge
-            boxes = driver.execute_script(_BOXES_JS)
-            for name in ("plan", "xz", "yz", "depth", "glare"):
-                left, _, right, bottom = boxes[name]
-                assert left >= 0 and right <= 1000 and bottom <= 800, (name, boxes[name])
-            assert boxes["plan"][2] <= boxes["xz"][0]  # the sections beside the plan view
-            assert not driver.execute_script(
-                "return document.getElementById('holoradar-loading') !== null")
-            _shot(driver, tmp_path, "viewer_1000x800.png")
-            assert not _console_errors(driver)
-            chrome, _, _ = find_chromium()
-            plain = tmp_path / "plain.png"
-            subprocess.run([chrome, "--headless", "--no-sandbox", "--disable-gpu",
-                            "--hide-scrollbars", "--window-size=1000,800",
-                            f"--screenshot={plain}", server.url],
-                           capture_output=True, timeout=120)
-            pixels = imread(plain)[..., :3]
-            assert (pixels.min(axis=-1) < 0.5).sum() > 200, "a blank page"
+        driver.get(server.url)
+        wait_idle(driver)
+        scroll_w, inner_w = driver.execute_script(
+            "return [document.documentElement.scrollWidth, window.innerWidth]")
+        assert inner_w == 1000 and scroll_w <= inner_w  # nothing beyond the right edge
+        boxes = driver.execute_script(_BOXES_JS)
+        for name in ("plan", "xz", "yz", "depth", "glare"):
+            left, _, right, bottom = boxes[name]
+            assert left >= 0 and right <= 1000 and bottom <= 800, (name, boxes[name])
+        assert boxes["plan"][2] <= boxes["xz"][0]  # the sections beside the plan view
+        assert not driver.execute_script(
+            "return document.getElementById('holoradar-loading') !== null")
+        _shot(driver, tmp_path, "viewer_1000x800.png")
+        assert not _console_errors(driver)
+        chrome, _, _ = find_chromium()
+        plain = tmp_path / "plain.png"
+        subprocess.run([chrome, "--headless", "--no-sandbox", "--disable-gpu",
+                        "--hide-scrollbars", "--window-size=1000,800",
+                        f"--screenshot={plain}", server.url],
+                       capture_output=True, timeout=120)
+        pixels = imread(plain)[..., :3]
+        assert (pixels.min(axis=-1) < 0.5).sum() > 200, "a blank page"
     finally:
         driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+        driver.get("about:blank")
+        driver.get_log("browser")
 
 
 _ROWS_JS = """
