@@ -128,9 +128,6 @@ def spectral_quadrant(shape: tuple[int, int], dx: float, dy: float
     return p, q, q[:, None] ** 2 + p[None, :] ** 2, unfold
 
 
-_FREE = FREE_SPACE
-
-
 def lateral_travel(k: float, medium: Medium, kappa2: np.ndarray, z: float, *,
                    below_surface: bool = False) -> np.ndarray:
     """Lateral distance per unit transverse wavenumber, ``sum_j h_j / Re(kz_j)`` (m^2/rad).
@@ -421,7 +418,7 @@ class _PlaneOperator(ABC):
         self.shape = (int(shape[0]), int(shape[1]))
         self.dx, self.dy, self.k = float(dx), float(dy), float(k)
         self.z = np.atleast_1d(np.asarray(z, dtype=float))
-        self.medium = medium if medium is not None else _FREE
+        self.medium = medium if medium is not None else FREE_SPACE
         self.monostatic = bool(monostatic)
         # The round trip halves the effective wavelength (wavenumber 2k).
         lam = (np.pi if self.monostatic else 2 * np.pi) / self.k

@@ -73,19 +73,16 @@ def read_frame(path: str, geometry: FrameGeometry | None,
     return (None, problem) if problem else (holo, None)
 
 
-def image_frame(path: str, name: str, job: Job,
-                read: tuple[Hologram | None, str | None] | None = None
-                ) -> tuple[dict[str, Any], Any]:
+def image_frame(path: str, name: str, job: Job) -> tuple[dict[str, Any], Any]:
     """Read and image one frame: ``(record, (image data, position))``, or ``(record,
     None)`` for a frame that cannot be imaged.
 
-    ``read``: the frame's :func:`read_frame` result, if it was read already. The
-    record is ``{"name", "status", ...}``: ``status`` ``"done"`` or ``"skipped"``
+    The record is ``{"name", "status", ...}``: ``status`` ``"done"`` or ``"skipped"``
     (with a ``reason``); with ``job.strict`` a frame that cannot be imaged raises
     ``ValueError`` instead. Nothing is written here
     (:func:`process_chunk` writes, and gathers the warnings).
     """
-    holo, problem = read_frame(path, job.geometry, job.layout) if read is None else read
+    holo, problem = read_frame(path, job.geometry, job.layout)
     result = None
     if holo is not None:
         s = job.settings
