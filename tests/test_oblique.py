@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.analysis.theory import range_resolution
 from holoradar.physics.green import layered_green
+from holoradar.theory import range_resolution
 
 F0 = 9.9e9
 K0 = 2 * np.pi * F0 / hr.C0
@@ -426,7 +426,7 @@ def test_effective_distance_is_where_a_free_space_sweep_focuses(target):
     finite-aperture focal shift (theory.focal_shift; 1.4-1.5 cm here). Bound: a
     quarter of the longitudinal resolution (12.7 cm for this 40 cm array at
     0.37 m). Measured: 1.1 and 1.5 cm off."""
-    from holoradar.analysis import theory
+    from holoradar import theory
 
     sand = hr.Medium.half_space(0.30, 2.5)
     pose = hr.Pose((0.0, -0.15, 0.05), tilt=np.radians(35), azimuth=np.radians(90))

@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # what static checkers and IDEs see
     from . import calibrate, survey, theory
     from ._validate import AliasingWarning
-    from .analysis.detect import detect, rebar_layers
+    from ._version import __version__
+    from .analysis.detect import detect, rebar_layers, unbiased_peak
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
     from .app.report import report
     from .data.hologram import C0, Hologram, Image
@@ -53,6 +54,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
 # module compiled afresh), and `hr.migrate` etc. behave as plain attributes.
 _SUBMODULES = ("calibrate", "survey", "theory")
 _NAMES = {
+    "__version__": "._version",
     "AliasingWarning": "._validate",
     "AngularSpectrum": ".physics.propagation",
     "Aperture": ".model.scene",
@@ -85,6 +87,7 @@ _NAMES = {
     "check_iq_sign": ".imaging.iq",
     "conjugate": ".data.wideband",
     "detect": ".analysis.detect",
+    "unbiased_peak": ".analysis.detect",
     "rebar_layers": ".analysis.detect",
     "estimate_permittivity": ".imaging.glare",
     "iq_convention": ".imaging.iq",
@@ -115,7 +118,6 @@ def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
 
 
-__version__ = "0.1.0"
 
 __all__ = [
     "C0",
@@ -167,4 +169,5 @@ __all__ = [
     "survey",
     "synthesize",
     "theory",
+    "unbiased_peak",
 ]

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import theory
 from .._validate import AliasingWarning
-from ..analysis import theory
 from ..analysis.metrics import peak_position
 from ..imaging.migrate import migrate
 from ..model.simulate import simulate

@@ -15,8 +15,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from ..analysis.theory import SpectralWindow
 from ..data.hologram import Hologram, Image
+from ..theory import SpectralWindow
 from .view.display import CM, scaled
 
 __all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_planes", "plot_section",

@@ -24,7 +24,7 @@ SUFFIXES = (".nc", ".nc4")
 
 
 def _version() -> str:
-    from .. import __version__
+    from .._version import __version__
 
     return __version__
 

@@ -308,7 +308,7 @@ def fit_calibration(references: Sequence[Reference], *, dark: RawFrames | None =
     bad = find_bad_elements(repeats, models[0], dead_below=dead_below, noisy_above=noisy_above)
     response = equalize_frequencies(reference, models[0], bad.mask)
     gains = element_gains(reference, models[0], response)
-    from .. import __version__
+    from .._version import __version__
 
     provenance = {
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),

@@ -315,58 +315,37 @@ class Image:
         """``|data|^2``."""
         return np.abs(self.data) ** 2
 
-    def peak(self, unbiased: bool = False, *, hologram: Any = None, medium: Any = None,
-             migrate_options: Any = None) -> tuple[float, float, float]:
-        """Where the brightest object is, metres.
+    def peak(self, unbiased: bool = False, **fit: Any) -> tuple[float, float, float]:
+        """``(x, y, z)`` of the brightest voxel over all planes, metres.
+
+        The brightest voxel is not where the object is: along the line of sight the
+        image's maximum is pulled towards the array (at one frequency by centimetres).
+        The object's own position, fitted to the hologram with its uncertainty, is
+        :func:`holoradar.unbiased_peak` ``(image, hologram, medium)``.
 
         Parameters
         ----------
         unbiased : bool
-            False (default): ``(x, y, z)`` of the brightest pixel over all planes.
-            True: the position of the object that makes it, by the point-response
-            fit :func:`holoradar.detect` uses (the maximum of the normalised
-            matched filter on ``hologram``): no pull towards the array along the
-            line of sight, range fitted even from one plane; the result also
-            carries ``.std`` (standard deviations, metres). See
-            :func:`holoradar.analysis.detect.peak.unbiased_peak`.
-        hologram : Hologram
-            With ``unbiased``: the hologram the image was migrated from (one frame,
-            a level array at z = 0; a tilted array is refused).
-        medium : Medium, optional
-            With ``unbiased``: the ground the image was formed through.
-        migrate_options : mapping, optional
-            With ``unbiased``: ``migrate``'s other arguments the image was made with.
+            Must be False: the fitted position is :func:`holoradar.unbiased_peak`
+            (a ``ValueError`` says so).
 
         Returns
         -------
         tuple of float
-            ``(x, y, z)``; with ``unbiased`` a
-            :class:`~holoradar.analysis.detect.peak.PeakPosition` (a 3-tuple with
-            ``.std``).
+            ``(x, y, z)``, metres.
 
         Examples
         --------
-        A point 10 cm deep in sand under an array 30 cm above it, one frequency:
-        the brightest pixel lies short of it (the focus is long and the adjoint's
-        weighting pulls it towards the array); the fit finds the point.
-
-        >>> import holoradar as hr
-        >>> sand = hr.Medium.half_space(0.30, 2.5)
-        >>> h = hr.simulate(hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget((0.0, 0.0, 0.40))]),
-        ...                 hr.Aperture.grid(16, 0.02), 9.9e9, include_surface=False,
-        ...                 snr_db=40, seed=0)
-        >>> img = hr.migrate(h, [0.34, 0.37, 0.40, 0.43], medium=sand)
-        >>> x, y, z = img.peak(unbiased=True, hologram=h, medium=sand)
-        >>> abs(z - 0.40) < 0.005
-        True
+        >>> img = Image(np.zeros((2, 3, 4)), np.arange(4.0), np.arange(3.0),
+        ...             np.array([0.1, 0.2]), 9.9e9)
+        >>> img.data[1, 2, 3] = 1.0
+        >>> img.peak()
+        (3.0, 2.0, 0.2)
         """
-        if unbiased:
-            from ..analysis.detect.peak import unbiased_peak
-
-            return unbiased_peak(self, hologram, medium, migrate_options)
-        if hologram is not None or medium is not None or migrate_options is not None:
-            raise ValueError("peak(): hologram=, medium= and migrate_options= are for "
-                             "unbiased=True")
+        if unbiased or fit:
+            raise ValueError("Image.peak() is the brightest voxel; the object's fitted "
+                             "position is holoradar.unbiased_peak(image, hologram, medium, "
+                             "migrate_options)")
         a = np.abs(self.data)
         if not self.has_z_axis:
             a = a[..., None, :, :]

@@ -44,8 +44,8 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._validate import AliasingWarning
-from ..analysis.noise import smooth_residual_energy
 from ..data.hologram import C0, Hologram
+from ..data.noise import smooth_residual_energy
 from ..physics.medium import Medium
 from .migrate import migrate
 from .point_response import PointResponse

@@ -21,8 +21,8 @@ from .. import _threads
 from .._lazy import lazy_module
 from .._threads import pool
 from .._validate import AliasingWarning, as_real, check_nonnegative_ranges, warn_if_aliased
-from ..analysis.noise import estimate_snr
 from ..data.hologram import C0, Hologram, Image
+from ..data.noise import estimate_snr
 from ..physics.incident import incident_phasors
 from ..physics.medium import FREE_SPACE, Medium
 from ..physics.propagation import (
@@ -101,7 +101,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     snr_db : float, optional
         Signal-to-noise ratio of the hologram, dB, that limits the loss
         compensation. Default: estimated from the part of its spectrum that is
-        evanescent over the air gap (:func:`~holoradar.analysis.noise.estimate_snr`),
+        evanescent over the air gap (:func:`~holoradar.data.noise.estimate_snr`),
         which needs a pitch below half a wavelength; otherwise 40 dB.
     dtype : numpy dtype, optional
         Working precision: ``np.complex64`` for speed; default that of the data.

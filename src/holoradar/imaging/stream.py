@@ -23,12 +23,12 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._threads import fft_workers
-from ..analysis.theory import lateral_resolution
 from ..data.hologram import Hologram, Image
 from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
 from ..physics.propagation import AngularSpectrum
 from ..physics.sources import PointSource
+from ..theory import lateral_resolution
 from .glare import FitWarning, _direct_wave, suppress_surface
 from .migrate import _zero_pad_spectrum
 from .synthesis import _check_views

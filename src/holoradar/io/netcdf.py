@@ -58,7 +58,7 @@ _SOURCES = {cls.__name__: cls for cls in (PlaneWave, PointSource, GaussianBeam, 
 
 
 def _version() -> str:
-    from .. import __version__
+    from .._version import __version__
 
     return __version__
 

@@ -9,7 +9,8 @@ sums a rebar mat's lines up per direction. See docs/detect.md.
 """
 
 from .api import detect
+from .peak import PeakPosition, unbiased_peak
 from .rebar import rebar_layers
 from .table import COLUMNS
 
-__all__ = ["COLUMNS", "detect", "rebar_layers"]
+__all__ = ["COLUMNS", "PeakPosition", "detect", "rebar_layers", "unbiased_peak"]

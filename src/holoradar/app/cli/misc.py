@@ -73,7 +73,7 @@ _POSITIVE = click.FloatRange(min=0, min_open=True)
 @output_options
 def theory_cmd(frequency: float, aperture: float, distance: float, report: Reporter) -> None:
     """Resolution and sampling figures for an aperture and range."""
-    from ...analysis import theory as th
+    from ... import theory as th
 
     if frequency < 1e8:
         raise click.BadParameter(f"{frequency:g} Hz is below 100 MHz: given in GHz? (Hz "

@@ -142,7 +142,7 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
     >>> summary["n_objects"], out.read_text().startswith("<!DOCTYPE html>")
     (1, True)
     """
-    from ... import __version__
+    from ..._version import __version__
     from ...io.output import check_output
     from ..atomic import write_atomic
     from .figures import pictures

@@ -68,11 +68,11 @@ def _model_error_bound(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
     Receiver noise is white over the aperture; what the model misses (a vector field
     seen as a scalar one, a layered ground seen as a half-space, a solver's own
     dispersion) is smooth from element to element. Its energy ``E_err``
-    (:func:`~holoradar.analysis.noise.smooth_residual_energy`), were it aligned with
+    (:func:`~holoradar.data.noise.smooth_residual_energy`), were it aligned with
     the worst direction, moves parameter j by ``sqrt(E_err [(J^T J)^-1]_jj)``
     (least squares, J the residual's Jacobian). Zero when the residual is white.
     """
-    from ...analysis.noise import smooth_residual_energy
+    from ...data.noise import smooth_residual_energy
 
     n = fun.size // 2
     e_err = smooth_residual_energy((fun[:n] + 1j * fun[n:]).reshape(shape))

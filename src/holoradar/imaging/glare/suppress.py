@@ -16,12 +16,12 @@ from typing import Any, Literal
 import numpy as np
 
 from ..._lazy import lazy_module
-from ...analysis.theory import lateral_resolution
 from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.propagation import AngularSpectrum
 from ...physics.sources import GaussianBeam, PointSource
+from ...theory import lateral_resolution
 from ._common import _direct_wave, _joint_direct, _recorded, _require_direct_wave
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source

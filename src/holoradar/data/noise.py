@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._lazy import lazy_module
-from ..data.hologram import Hologram
+from .hologram import Hologram
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
