@@ -1,0 +1,121 @@
+"""What :func:`~holoradar.autofocus` returns: the estimate, its interval, and how it was made."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...physics.medium import Medium
+from .interval import quantile
+
+__all__ = ["AutofocusResult"]
+
+
+@dataclass(frozen=True)
+class AutofocusResult:
+    """What :func:`autofocus` found.
+
+    Attributes
+    ----------
+    eps : float or None
+        Estimated real relative permittivity eps' of the ground (combined with the
+        glare's estimate when one was used); ``None`` when not determinable.
+    eps_interval : tuple of float or None
+        Its confidence interval (``confidence``).
+    determinable : bool
+        False when the data give no handle on eps' (then ``reason`` says why).
+    reason : str
+        Why not determinable, or how the estimate was made.
+    confidence : float
+    position : tuple of float or None
+        The object (x, y, z) at the estimate, metres (z the range from the
+        aperture).
+    range_interval : tuple of float or None
+        The object's range over ``eps_interval``, metres.
+    depth : float or None
+        The object's depth below the ground surface, metres.
+    eps_focus, eps_focus_interval
+        The focus's own estimate and interval (also when a glare was combined).
+    eps_glare, eps_glare_std
+        The glare's estimate and 1-sigma, when used.
+    focus_fraction : float
+        The share of the hologram's energy the object explains at the estimate.
+    detection : float
+        The object's matched-filter output over the residual noise level, and
+        ``detection_threshold`` the level noise alone exceeds with 1e-3 chance.
+    noise_inflation : float
+        The sandwich factor phi (1 for white residuals).
+    handle : str
+        What fixes eps': the wave front's shape (one frequency) or the delays too.
+    eps_grid, profile : ndarray
+        The eps' tried and the best focus fraction at each (sorted by eps').
+    evaluations : int
+        Point responses evaluated (the field of one trial object at every element
+        and frequency: the work of one trial).
+    integrals : int
+        Sommerfeld integrals computed (one per frequency, trial eps' and range;
+        each serves many trials).
+    seconds : float
+    medium : Medium or None
+        The ground model at the estimate.
+
+    Examples
+    --------
+    >>> from holoradar.imaging.autofocus import AutofocusResult
+    >>> res = AutofocusResult(4.02, (3.76, 4.32), True, "from the focus", 0.95,
+    ...                       eps_focus=4.02, handle="one frequency: the wave front's shape")
+    >>> print(res)
+    eps' = 4.02 (95% interval 3.76 .. 4.32) (one frequency: the wave front's shape)
+    >>> round(res.std, 3)
+    0.143
+    >>> print(AutofocusResult(None, None, False, "no object", 0.95))
+    eps' not determinable: no object
+    """
+
+    eps: float | None
+    eps_interval: tuple[float, float] | None
+    determinable: bool
+    reason: str
+    confidence: float
+    position: tuple[float, float, float] | None = None
+    range_interval: tuple[float, float] | None = None
+    depth: float | None = None
+    eps_focus: float | None = None
+    eps_focus_interval: tuple[float, float] | None = None
+    eps_glare: float | None = None
+    eps_glare_std: float | None = None
+    focus_fraction: float = 0.0
+    detection: float = 0.0
+    detection_threshold: float = 0.0
+    noise_inflation: float = 1.0
+    handle: str = ""
+    eps_grid: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False,
+                                 compare=False)
+    profile: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False, compare=False)
+    evaluations: int = 0
+    integrals: int = 0
+    seconds: float = 0.0
+    medium: Medium | None = field(default=None, repr=False)
+    line_azimuth_deg: float | None = None
+    line_length: float | None = None
+
+    @property
+    def std(self) -> float | None:
+        """Equivalent 1-sigma of eps' (half the interval over the normal quantile)."""
+        if self.eps_interval is None:
+            return None
+        return (self.eps_interval[1] - self.eps_interval[0]) / (2 * quantile(self.confidence))
+
+    def __str__(self) -> str:
+        if not self.determinable:
+            return f"eps' not determinable: {self.reason}"
+        lo, hi = self.eps_interval
+        # Enough decimals that the interval's width shows (2 at least).
+        d = max(2, 1 - int(np.floor(np.log10(max(hi - lo, 1e-12)))))
+        text = (f"eps' = {self.eps:.{d}f} ({100 * self.confidence:.0f}% interval {lo:.{d}f} .. "
+                f"{hi:.{d}f})")
+        if self.position is not None and self.depth is not None:
+            text += (f"; object at range {self.position[2]:.4g} m, {self.depth:.4g} m below the "
+                     "surface")
+        return f"{text} ({self.handle if self.eps_focus is not None else self.reason})"
