@@ -4,7 +4,6 @@ worker processes (a local cluster started for the run, or Dask's schedulers)."""
 from __future__ import annotations
 
 import os
-import shutil
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -18,6 +17,8 @@ from ..physics.medium import Medium
 from . import schedule
 from .frames import FrameGeometry
 from .settings import Settings
+from .space import bytes_text as bytes_text  # re-exported: the command line's sizes
+from .space import folder_bytes, plan_space
 from .store import (
     create_store,
     file_stamp,
@@ -266,46 +267,6 @@ def _interrupted(target: Path, given: list[Path]) -> BatchInterrupted:
     return BatchInterrupted(str(target), stored, len(asked))
 
 
-def bytes_text(n: float) -> str:
-    """Bytes for a person: ``3.43 GB`` (powers of 1000).
-
-    Examples
-    --------
-    >>> bytes_text(3.43e9), bytes_text(468512), bytes_text(512)
-    ('3.43 GB', '469 kB', '512 bytes')
-    """
-    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if n >= scale:
-            return f"{n / scale:.3g} {unit}" if n < 10 * scale else f"{n / scale:.0f} {unit}"
-    return f"{int(n)} bytes"
-
-
-def _folder_bytes(path: Path) -> int:
-    return sum(f.stat().st_size for f in path.rglob("*") if f.is_file())
-
-
-def _plan(target: Path, settings: Settings, geometry: FrameGeometry, n_frames: int, *,
-          reclaimed: int = 0) -> dict[str, Any]:
-    """The store's growth for ``n_frames`` images; ValueError when the disk cannot hold it.
-
-    ``reclaimed``: bytes freed once the new store is in place (an old store replaced).
-    The size before compression is the bound: compression saves only about a tenth.
-    """
-    per = frame_bytes(settings, geometry)
-    need = n_frames * per
-    free = shutil.disk_usage(target.parent).free + reclaimed
-    shape = geometry.image_shape(settings.z.size, settings.upsample)
-    dtype = "float32" if geometry.dtype == "complex64" else "float64"
-    if need > free:
-        raise ValueError(
-            f"store {str(target)!r} would need up to {bytes_text(need)} for {n_frames} frames "
-            f"({bytes_text(per)} each: {shape[0]} planes of {shape[2]} x {shape[1]} pixels, I and "
-            f"Q as {dtype}) but its disk has {bytes_text(free)} free: free some space, put the "
-            "store on another disk, or image fewer planes or at a smaller upsample")
-    return {"frames": n_frames, "bytes": need, "bytes_per_frame": per,
-            "image_shape": list(shape), "dtype": dtype, "free": free, "store": str(target)}
-
-
 def _layout_text(layout: Any) -> Any:
     """A layout as something every worker can be sent (checked here, once)."""
     from ..io import _as_layout
@@ -380,8 +341,8 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
                              + "; ".join(f"{s['name']}: {s['reason']}" for s in skipped[:3]))
         geometry = found
         # Before the store is laid out: a refused run writes nothing.
-        plan = _plan(target, settings, geometry, len(frames_in),
-                     reclaimed=_folder_bytes(target) if exists else 0)
+        plan = plan_space(target, settings, geometry, len(frames_in),
+                          reclaimed=folder_bytes(target) if exists else 0)
         create_store(target, settings, geometry, replace=exists,
                      chunk=frames_per_chunk(frame_bytes(settings, geometry), len(frames_in)))
 
@@ -391,7 +352,7 @@ def _run(given: list[Path], target: Path, settings: Settings, sched: str, client
     todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, frames_in, strict=True)
             if not done[slot]]
     if todo and not fresh:  # (a new store was checked before it was laid out)
-        plan = _plan(target, settings, geometry, len(todo))
+        plan = plan_space(target, settings, geometry, len(todo))
     if todo and on_start is not None:
         on_start(plan)
     token = uuid.uuid4().hex
