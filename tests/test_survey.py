@@ -322,7 +322,7 @@ def test_size_is_said_before_and_a_full_disk_refused(survey_frames, tmp_path: Pa
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     import shutil as sh
 
-    from holoradar.survey import batch as survey_batch
+    from holoradar.survey import space as survey_space
 
     paths, _ = survey_frames
     per = 2 * 8 * 8 * 2 * 8  # 2 planes of 8 x 8 pixels, I and Q as float64
@@ -344,7 +344,7 @@ def test_size_is_said_before_and_a_full_disk_refused(survey_frames, tmp_path: Pa
     def tiny(path):
         return real(path)._replace(free=3 * per)
 
-    monkeypatch.setattr(survey_batch.shutil, "disk_usage", tiny)
+    monkeypatch.setattr(survey_space.shutil, "disk_usage", tiny)
     with pytest.raises(ValueError, match=r"would need up to 10 kB for 5 frames \(2.05 kB "
                        r"each: 2 planes of 8 x 8 pixels, I and Q as float64\) but its disk "
                        r"has 6.14 kB free: free some space"):

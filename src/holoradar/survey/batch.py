@@ -1,36 +1,44 @@
 """``run_batch``: image every frame of a survey with the same settings, on one or more
-worker processes (a local cluster started for the run, or Dask's schedulers)."""
+worker processes (a local cluster started for the run, or Dask's schedulers).
+
+The steps of a run: the arguments checked (:func:`run_batch`); the frames made distinct
+and checked (:mod:`holoradar.survey.intake`); the store laid out, or an existing one
+resumed; the frames left imaged where the scheduler says
+(:mod:`holoradar.survey.execute`); the frames found bad remembered in the store, and
+the summary returned.
+"""
 
 from __future__ import annotations
 
 import os
-import shutil
 import time
 import uuid
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..io.output import check_output
 from ..physics.medium import Medium
 from . import schedule
+from .checks import check_store, frame_paths, layout_text, where_asked
+from .execute import AUTO_CLUSTER_S as AUTO_CLUSTER_S  # re-exported: documented here
+from .execute import OWN, Placement, Todo, run_chunks
 from .frames import FrameGeometry
+from .intake import Intake, check_frames, drop_remembered, drop_unreadable, remember
 from .settings import Settings
+from .space import bytes_text as bytes_text  # re-exported: the command line's sizes
+from .space import folder_bytes, plan_space
 from .store import (
     create_store,
-    file_stamp,
     frame_bytes,
     frames_per_chunk,
     is_survey,
-    note_skipped,
     read_index,
     register_frames,
     remembered_bad,
     stored_settings,
 )
-from .worker import Job, drain_writes, process_chunk, read_frame
+from .worker import Job
 
 __all__ = ["BatchInterrupted", "SettingsMismatchError", "run_batch"]
 
@@ -209,38 +217,16 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     """
     t0 = time.perf_counter()
     settings = Settings.make(z, medium, method, upsample)
-    n_workers = schedule.check_workers(workers)
-    if n_workers is not None and scheduler is not None:
-        raise ValueError(f"give workers (a local cluster started for the run) or scheduler, "
-                         f"not both: got workers={workers!r}, scheduler={scheduler!r}")
-    sched = "auto" if scheduler is None else schedule.check_scheduler(scheduler)
-    if n_workers is not None:
-        sched = "in-process" if n_workers == 1 else "local cluster"
-    if isinstance(frames, str | os.PathLike):
-        raise ValueError("frames must be a sequence of paths (a list), not one path")
-    given = [Path(f) for f in frames]
-    if not given:
-        raise ValueError("frames: no frames given")
-    target = check_output(store, suffixes=[".zarr"], inputs=given, overwrite=True, name="store",
-                          folder=True)
-    # A frame inside the store's folder: only where that folder exists already.
-    root = target.resolve() if target.exists() else None
-    inside = [p for p in given if root is not None and root in p.resolve().parents]
-    if inside:
-        raise ValueError(f"store {str(target)!r} holds the frame {str(inside[0])!r}: refusing "
-                         "to write into (or replace) the folder of the data")
-    exists = target.exists()
-    if exists and not is_survey(target):
-        raise ValueError(f"store {str(target)!r} exists and is not a holoradar survey store: "
-                         "refusing to touch it (choose another path or remove it)")
-
+    sched, n_workers = where_asked(workers, scheduler)
+    given = frame_paths(frames)
+    target, exists = check_store(store, given)
     # A cluster is reached before anything is written (an unreachable address is an error).
-    client = schedule.connect(sched) if sched not in (*schedule.LOCAL, *_OWN) else None
+    client = schedule.connect(sched) if sched not in (*schedule.LOCAL, *OWN) else None
     try:
-        summary = _run(given, target, settings, sched, client, strict=bool(strict),
-                       overwrite=overwrite, exists=exists, progress=progress,
-                       layout=_layout_text(layout), on_start=on_start,
-                       workers=n_workers, retry_bad=bool(retry_bad))
+        run = _Run(target, settings, sched, client, n_workers, bool(strict),
+                   layout_text(layout), progress)
+        summary = _run(run, given, exists=exists, overwrite=overwrite,
+                       retry_bad=bool(retry_bad), on_start=on_start)
     except KeyboardInterrupt:
         # The workers have stopped (run_tasks): what the store holds now is what a
         # rerun finds. "from None": the interrupted frame's traceback says nothing.
@@ -266,267 +252,125 @@ def _interrupted(target: Path, given: list[Path]) -> BatchInterrupted:
     return BatchInterrupted(str(target), stored, len(asked))
 
 
-def bytes_text(n: float) -> str:
-    """Bytes for a person: ``3.43 GB`` (powers of 1000).
+@dataclass(frozen=True)
+class _Run:
+    """A run's arguments, once checked (see :func:`run_batch`)."""
 
-    Examples
-    --------
-    >>> bytes_text(3.43e9), bytes_text(468512), bytes_text(512)
-    ('3.43 GB', '469 kB', '512 bytes')
-    """
-    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if n >= scale:
-            return f"{n / scale:.3g} {unit}" if n < 10 * scale else f"{n / scale:.0f} {unit}"
-    return f"{int(n)} bytes"
-
-
-def _folder_bytes(path: Path) -> int:
-    return sum(f.stat().st_size for f in path.rglob("*") if f.is_file())
+    target: Path  # the store
+    settings: Settings
+    sched: str  # as checks.where_asked says
+    client: Any  # the connection to a cluster's address (None: no address)
+    workers: int | None  # local workers asked
+    strict: bool
+    layout: Any  # as checks.layout_text says
+    progress: bool
 
 
-def _plan(target: Path, settings: Settings, geometry: FrameGeometry, n_frames: int, *,
-          reclaimed: int = 0) -> dict[str, Any]:
-    """The store's growth for ``n_frames`` images; ValueError when the disk cannot hold it.
+@dataclass(frozen=True)
+class _Imaged:
+    """What the imaging of a run produced: a record per frame tried, and where."""
 
-    ``reclaimed``: bytes freed once the new store is in place (an old store replaced).
-    The size before compression is the bound: compression saves only about a tenth.
-    """
-    per = frame_bytes(settings, geometry)
-    need = n_frames * per
-    free = shutil.disk_usage(target.parent).free + reclaimed
-    shape = geometry.image_shape(settings.z.size, settings.upsample)
-    dtype = "float32" if geometry.dtype == "complex64" else "float64"
-    if need > free:
-        raise ValueError(
-            f"store {str(target)!r} would need up to {bytes_text(need)} for {n_frames} frames "
-            f"({bytes_text(per)} each: {shape[0]} planes of {shape[2]} x {shape[1]} pixels, I and "
-            f"Q as {dtype}) but its disk has {bytes_text(free)} free: free some space, put the "
-            "store on another disk, or image fewer planes or at a smaller upsample")
-    return {"frames": n_frames, "bytes": need, "bytes_per_frame": per,
-            "image_shape": list(shape), "dtype": dtype, "free": free, "store": str(target)}
+    records: tuple[dict[str, Any], ...]
+    placement: Placement
 
 
-def _layout_text(layout: Any) -> Any:
-    """A layout as something every worker can be sent (checked here, once)."""
-    from ..io import _as_layout
-
-    return _as_layout(layout)
-
-
-_OWN = ("auto", "in-process", "local cluster")  # run here, or on a cluster started here
-
-AUTO_CLUSTER_S = 10.0
-"""With ``workers=None``: the least time (s) the frames left after the first chunk would
-take in this process for a local cluster to be started for them. Starting one costs
-2 to 5 s (its processes start and import the imaging code; measured on 2 cores,
-benchmarks/results_batch.json), so below this the run stays in this process."""
-
-
-def _run(given: list[Path], target: Path, settings: Settings, sched: str, client: Any, *,
-         strict: bool, overwrite: bool, exists: bool, progress: bool,
-         layout: Any = None,
-         on_start: Callable[[dict[str, Any]], None] | None = None,
-         workers: int | None = None, retry_bad: bool = False) -> dict[str, Any]:
-    """The run itself, once the arguments are checked (see :func:`run_batch`)."""
+def _run(run: _Run, given: list[Path], *, exists: bool, overwrite: bool, retry_bad: bool,
+         on_start: Callable[[dict[str, Any]], None] | None) -> dict[str, Any]:
+    """The run itself, once the arguments are checked: its summary (see :func:`run_batch`)."""
     # Distinct frames, and the checks that need no reading, before anything is written.
-    frames_in: list[tuple[Path, str]] = []  # (absolute path, name as given)
-    seen: set[Path] = set()
-    skipped: list[dict[str, Any]] = []
-    for p in given:
-        key = p.resolve()
-        if key in seen:
-            continue
-        seen.add(key)
-        problem = (None if p.is_file() else "is not a file") or \
-            ("is empty" if p.stat().st_size == 0 else None)
-        if problem:
-            _skip(skipped, str(p), problem, strict)
-        else:
-            frames_in.append((key, str(p)))
-    n_frames = len(seen)
-    # The files' stamps before any is read: a frame found bad is remembered with these, so
-    # a file changed while the run read it is read again by the next run.
-    stamps = {str(k): file_stamp(k) for k, _ in frames_in}
-    read_bad: dict[str, str] = {}  # absolute path -> reason: found bad when read or imaged
-
-    fresh = overwrite or not exists  # a new store is laid out
-    if not fresh:
-        old, geometry = stored_settings(target)
-        diff = old.differences(settings)
-        if diff:
-            raise SettingsMismatchError(str(target), diff)
-        known_bad = {} if retry_bad else remembered_bad(target)
-        keep = []
-        for key, name in frames_in:
-            reason = known_bad.get(str(key))
-            if reason is None:
-                keep.append((key, name))
-                continue
-            if strict:
-                raise ValueError(f"frame {name!r}: {reason} (found by an earlier run; strict: "
-                                 "nothing was written; retry_bad reads it again)")
-            skipped.append({"name": name, "reason": reason, "remembered": True})
-            read_bad[str(key)] = reason
-        frames_in = keep
+    intake = check_frames(given, run.strict)
+    if overwrite or not exists:  # a new store is laid out
+        intake, geometry, plan = _lay_out(run, intake, replace=exists)
+        todo, chunk = _todo(run.target, intake)
     else:
-        found, refused = _reference(frames_in, strict, layout)
-        for name, reason in refused:
-            skipped.append({"name": name, "reason": reason})
-        refused_names = {name for name, _ in refused}
-        read_bad.update({str(k): r for k, n in frames_in for name, r in refused if n == name})
-        frames_in = [f for f in frames_in if f[1] not in refused_names]
-        if found is None:
-            raise ValueError(f"none of the {n_frames} frames can be imaged: "
-                             + "; ".join(f"{s['name']}: {s['reason']}" for s in skipped[:3]))
-        geometry = found
-        # Before the store is laid out: a refused run writes nothing.
-        plan = _plan(target, settings, geometry, len(frames_in),
-                     reclaimed=_folder_bytes(target) if exists else 0)
-        create_store(target, settings, geometry, replace=exists,
-                     chunk=frames_per_chunk(frame_bytes(settings, geometry), len(frames_in)))
+        intake, geometry = _resume(run, intake, retry_bad)
+        todo, chunk = _todo(run.target, intake)
+        # What is left must fit (a new store was checked before it was laid out).
+        plan = plan_space(run.target, run.settings, geometry, len(todo)) if todo else None
+    if todo and on_start is not None:
+        assert plan is not None  # (a plan whenever frames are left)
+        on_start(plan)
+    imaged = _image(run, geometry, intake, todo, chunk)
+    return _summary(run.target, intake, todo, imaged, plan)
 
-    slots = register_frames(target, [p for p, _ in frames_in])
+
+def _lay_out(run: _Run, intake: Intake, *,
+             replace: bool) -> tuple[Intake, FrameGeometry, dict[str, Any]]:
+    """A new store for the frames that can be imaged: those, the survey's geometry (the
+    first readable frame's) and the plan of its growth (``on_start``).
+
+    Everything is checked before the store is laid out: a refused run writes nothing.
+    ``replace``: a store exists there (removed once the new layout is in place; the space
+    it frees counts).
+    """
+    intake, geometry = drop_unreadable(intake, run.strict, run.layout)
+    plan = plan_space(run.target, run.settings, geometry, len(intake.frames),
+                      reclaimed=folder_bytes(run.target) if replace else 0)
+    create_store(run.target, run.settings, geometry, replace=replace,
+                 chunk=frames_per_chunk(frame_bytes(run.settings, geometry), len(intake.frames)))
+    return intake, geometry, plan
+
+
+def _resume(run: _Run, intake: Intake, retry_bad: bool) -> tuple[Intake, FrameGeometry]:
+    """An existing store, checked against the run's settings: the frames left once those
+    it remembers as bad are skipped (unless ``retry_bad``), and the survey's geometry."""
+    old, geometry = stored_settings(run.target)
+    diff = old.differences(run.settings)
+    if diff:
+        raise SettingsMismatchError(str(run.target), diff)
+    known_bad = {} if retry_bad else remembered_bad(run.target)
+    return drop_remembered(intake, known_bad, run.strict), geometry
+
+
+def _todo(target: Path, intake: Intake) -> tuple[Todo, int]:
+    """The frames not done yet, once each has its slot in the store: ``(slot, absolute
+    path, name)``; and the frames per chunk of the store."""
+    slots = register_frames(target, [p for p, _ in intake.frames])
     index = read_index(target)
     done, chunk = index["done"], int(index["group"]["image"].chunks[0])
-    todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, frames_in, strict=True)
+    todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, intake.frames, strict=True)
             if not done[slot]]
-    if todo and not fresh:  # (a new store was checked before it was laid out)
-        plan = _plan(target, settings, geometry, len(todo))
-    if todo and on_start is not None:
-        on_start(plan)
+    return todo, chunk
+
+
+def _image(run: _Run, geometry: FrameGeometry, intake: Intake, todo: Todo,
+           chunk: int) -> _Imaged:
+    """Image the frames of ``todo``; the frames found bad are remembered in the store, also
+    when the run stops early (Ctrl-C, an error: raised once they are)."""
     token = uuid.uuid4().hex
-    stop_file = target.with_name(f".{target.name}.{token}.stop")
+    stop_file = run.target.with_name(f".{run.target.name}.{token}.stop")
     # Dask's local pools wait for each task's writes; elsewhere a worker's last chunk is
     # written while it images its next task, and the writes are waited for at the end.
-    job = Job(str(target), token, settings, geometry, strict, layout,
-              stop_file=str(stop_file) if sched not in schedule.LOCAL else None,
-              drain=sched in ("threads", "processes"))
-    records: list[dict[str, Any]] = []
-    used = {"scheduler": sched, "workers": 1}
-
-    def remember() -> None:
-        # Why frames are missing, kept in the store for `holoradar info` and the next run
-        # (by absolute path), also when the run stops early.
-        by_name = {name: str(k) for k, name in frames_in}
-        for r in records:
-            if r["status"] == "skipped" and r["name"] in by_name:
-                read_bad[by_name[r["name"]]] = r["reason"]
-        reasons = {str(Path(k["name"]).resolve()): k["reason"] for k in skipped}
-        reasons.update(read_bad)
-        note_skipped(target, reasons, [str(p) for p in seen],
-                     {k: v for k, v in stamps.items() if k in read_bad and v is not None})
-
+    job = Job(str(run.target), token, run.settings, geometry, run.strict, run.layout,
+              stop_file=str(stop_file) if run.sched not in schedule.LOCAL else None,
+              drain=run.sched in ("threads", "processes"))
+    records: list[dict[str, Any]] = []  # filled as tasks end: kept if the run stops
     try:
-        if todo:
-            _execute(todo, chunk, job, sched, client, workers, progress, records, used)
+        placement = run_chunks(todo, chunk, job, run.sched, run.client, run.workers,
+                               run.progress, into=records) if todo else Placement(run.sched, 1)
     except BaseException:
         try:
-            remember()
+            remember(run.target, intake, records)
         except Exception:  # the run's own exception is the one to see
             pass
         raise
     else:
-        remember()
+        remember(run.target, intake, records)
     finally:
         stop_file.unlink(missing_ok=True)
-    skipped += [{"name": r["name"], "reason": r["reason"]} for r in records
-                if r["status"] == "skipped"]
-    return {"store": str(target), "frames": n_frames,
+    return _Imaged(tuple(records), placement)
+
+
+def _summary(target: Path, intake: Intake, todo: Todo, imaged: _Imaged,
+             plan: dict[str, Any] | None) -> dict[str, Any]:
+    """What :func:`run_batch` returns (``seconds`` set by it)."""
+    records = imaged.records
+    skipped = [*intake.skipped, *({"name": r["name"], "reason": r["reason"]} for r in records
+                                  if r["status"] == "skipped")]
+    return {"store": str(target), "frames": intake.count,
             "done": sum(r["status"] == "done" for r in records),
-            "resumed": len(frames_in) - len(todo), "skipped": skipped, "seconds": 0.0,
-            "scheduler": used["scheduler"], "workers": used["workers"],
+            "resumed": len(intake.frames) - len(todo), "skipped": skipped, "seconds": 0.0,
+            "scheduler": imaged.placement.scheduler, "workers": imaged.placement.workers,
             "remembered": sum(bool(k.get("remembered")) for k in skipped),
             "warnings": sorted({w for r in records for w in r.get("warnings", [])}),
-            "bytes_estimated": plan["bytes"] if todo else 0}
-
-
-def _execute(todo: list[tuple[int, str, str]], chunk: int, job: Job, sched: str, client: Any,
-             workers: int | None, progress: bool, records: list[dict[str, Any]],
-             used: dict[str, Any]) -> None:
-    """Run the tasks where ``sched`` says; records appended to ``records`` as tasks end.
-    Returns once every write of the run is done (or failed: its error is raised)."""
-    try:
-        _dispatch(todo, chunk, job, sched, client, workers, progress, records, used)
-    finally:
-        drain_writes()  # the writes of this process's tasks
-
-
-def _on_cluster(tasks: list[list[tuple[int, str, str]]], job: Job, client: Any,
-                progress: bool, records: list[dict[str, Any]]) -> None:
-    """The tasks on a ``dask.distributed`` cluster, then every worker's writes waited for."""
-    try:
-        schedule.run_tasks(process_chunk, tasks, job, "cluster", progress=progress,
-                           client=client, into=records)
-    except BaseException:
-        try:
-            client.run(drain_writes)
-        except Exception:  # the run's own error says more
-            pass
-        raise
-    client.run(drain_writes)  # a write's error is raised here
-
-
-def _dispatch(todo: list[tuple[int, str, str]], chunk: int, job: Job, sched: str, client: Any,
-              workers: int | None, progress: bool, records: list[dict[str, Any]],
-              used: dict[str, Any]) -> None:
-    if sched not in _OWN:  # Dask's local schedulers, or a cluster's address
-        n = schedule.cluster_workers(client) if client is not None \
-            else schedule.local_workers(sched)
-        used["workers"] = n
-        if client is not None:
-            _on_cluster(schedule.plan_tasks(todo, chunk), job, client, progress, records)
-        else:
-            schedule.run_tasks(process_chunk, schedule.plan_tasks(todo, chunk), job, sched,
-                               progress=progress, into=records)
-        return
-    tasks = schedule.plan_tasks(todo, chunk)
-    if sched == "in-process":
-        used["scheduler"] = "in-process"
-        schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
-        return
-    n = workers if sched == "local cluster" else schedule.usable_cores()
-    if sched == "auto":
-        # The first chunk here, timed; a cluster only for work that outlasts its start.
-        used["scheduler"] = "in-process"
-        if n < 2 or len(tasks) < 2:
-            schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
-            return
-        schedule.run_here(process_chunk, tasks[:1], job, into=records)
-        # A frame's time here: the median (the first one pays this process's imports).
-        times = [r["seconds"] for r in records if "seconds" in r]
-        per_frame = float(np.median(times)) if times else 0.0
-        tasks = tasks[1:]
-        left = sum(len(t) for t in tasks) * per_frame
-        if left < AUTO_CLUSTER_S:
-            schedule.run_here(process_chunk, tasks, job, progress=progress, into=records)
-            return
-        n = min(n, len(tasks))
-    assert n is not None
-    used["scheduler"], used["workers"] = "local cluster", n
-    cluster, own = schedule.local_cluster(n)
-    try:
-        _on_cluster(tasks, job, own, progress, records)
-    finally:
-        own.close()
-        cluster.close()
-
-
-def _skip(skipped: list[dict[str, str]], name: str, reason: str, strict: bool) -> None:
-    if strict:
-        raise ValueError(f"frame {name!r}: {reason} (strict: nothing was written)")
-    skipped.append({"name": name, "reason": reason})
-
-
-def _reference(frames: list[tuple[Path, str]], strict: bool,
-               layout: Any = None) -> tuple[FrameGeometry | None, list[tuple[str, str]]]:
-    """The geometry of the first frame that can be read, and the frames refused before it."""
-    refused: list[tuple[str, str]] = []
-    for path, name in frames:
-        holo, problem = read_frame(str(path), None, layout)
-        if holo is not None:
-            return FrameGeometry.of(holo), refused
-        assert problem is not None
-        if strict:
-            raise ValueError(f"frame {name!r}: {problem} (strict: nothing was written)")
-        refused.append((name, problem))
-    return None, refused
+            "bytes_estimated": plan["bytes"] if todo and plan is not None else 0}
