@@ -22,7 +22,6 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from ._validate import AliasingWarning
     from .analysis.detect import detect, rebar_layers
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
-    from .app.report import report
     from .data.hologram import C0, Hologram, Image
     from .data.pose import Pose
     from .data.wideband import apply_calibration, conjugate, remove_mean
@@ -47,6 +46,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from .physics.parabolic import ParabolicEquation
     from .physics.propagation import AngularSpectrum, Fresnel
     from .physics.sources import GaussianBeam, PlaneWave, PointSource
+    from .reporting import report
 
 # The public names, each imported from its module on first use (PEP 562): `import
 # holoradar` then costs little more than numpy even where bytecode is not cached (every
@@ -93,7 +93,7 @@ _NAMES = {
     "permittivity": ".physics.medium",
     "plan_oblique": ".analysis.oblique_plan",
     "remove_mean": ".data.wideband",
-    "report": ".app.report",
+    "report": ".reporting",
     "save": ".io",
     "simulate": ".model.simulate",
     "suppress_surface": ".imaging.glare",
