@@ -66,13 +66,10 @@ def make_survey(folder: Path, n: int) -> tuple[Path, int]:
 def detect_only(store: Path, z: float | None, table: bool = False) -> object:
     """``holoradar detect STORE``'s work: the objects of every frame, merged (their
     number, or with ``table`` the table)."""
-    from holoradar.app.cli.detect import _from_store
-    from holoradar.app.report.sources import _Silent
+    from holoradar.survey.detect import from_store
 
-    spec = dict.fromkeys(("eps", "z_surface", "layers", "medium_file", "tan_delta", "sigma"))
-    df, _, _ = _from_store(store, None if z is None else repr(z), spec,
-                           {"false_alarm": 1e-3, "kinds": ("point", "line", "area"),
-                            "eps_interval": None}, _Silent())
+    df, _, _ = from_store(store, z, {"false_alarm": 1e-3, "kinds": ("point", "line", "area"),
+                                     "eps_interval": None})
     return df if table else len(df)
 
 

@@ -12,7 +12,7 @@ import pytest
 
 import holoradar as hr
 from cli_helpers import one_line_error, run
-from holoradar.app.cli.detect import geojson
+from holoradar.io.detections import geojson
 
 warnings.filterwarnings("ignore", category=hr.AliasingWarning)
 pytestmark = pytest.mark.filterwarnings("ignore::holoradar.AliasingWarning")

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 import holoradar as hr
-from holoradar.app.report.table import MISSING
+from holoradar.reporting.table import MISSING
 
 SAND = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
 # What the table shows of hr.detect's columns (metres, m^2, degrees, dB): the factor to

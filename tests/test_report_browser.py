@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.app.report.table import MISSING
 from holoradar.app.view.browser import find_chromium, headless_chromium
+from holoradar.reporting.table import MISSING
 
 _, _, WHY = find_chromium()
 pytestmark = [pytest.mark.browser,

@@ -469,8 +469,8 @@ def test_page_overlays_and_lists_the_objects(scene, tmp_path):
 
 def test_objects_files_of_holoradar_detect_are_read_back(tmp_path):
     # What `holoradar detect -o` writes (.csv, .json, .geojson) is what the page shows.
-    from holoradar.app.cli.detect import _write
     from holoradar.app.view.objects import overlay, read_objects
+    from holoradar.io.detections import write as _write
 
     df = _objects_table()
     for suffix in (".csv", ".json", ".geojson"):

@@ -427,7 +427,7 @@ def test_objects_of_a_file_are_overlaid_and_listed(rod, browser, tmp_path):
     import pandas as pd
 
     from holoradar.analysis.detect.table import COLUMNS
-    from holoradar.app.cli.detect import _write
+    from holoradar.io.detections import write as _write
 
     path, _, _ = rod
     nan = float("nan")

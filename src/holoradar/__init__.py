@@ -23,7 +23,6 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from ._version import __version__
     from .analysis.detect import detect, rebar_layers, unbiased_peak
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
-    from .app.report import report
     from .data.hologram import C0, Hologram, Image
     from .data.pose import Pose
     from .data.wideband import apply_calibration, conjugate, remove_mean
@@ -48,6 +47,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from .physics.parabolic import ParabolicEquation
     from .physics.propagation import AngularSpectrum, Fresnel
     from .physics.sources import GaussianBeam, PlaneWave, PointSource
+    from .reporting import report
 
 # The public names, each imported from its module on first use (PEP 562): `import
 # holoradar` then costs little more than numpy even where bytecode is not cached (every
@@ -96,7 +96,7 @@ _NAMES = {
     "permittivity": ".physics.medium",
     "plan_oblique": ".analysis.oblique_plan",
     "remove_mean": ".data.wideband",
-    "report": ".app.report",
+    "report": ".reporting",
     "save": ".io",
     "simulate": ".model.simulate",
     "suppress_surface": ".imaging.glare",

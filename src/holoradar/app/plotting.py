@@ -6,37 +6,21 @@ Every function returns a :class:`matplotlib.figure.Figure` built without pyplot
 
 from __future__ import annotations
 
-import io
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
+from .._figures import edges as _edges
+from .._figures import to_png
 from ..data.hologram import Hologram, Image
 from ..theory import SpectralWindow
 from .view.display import CM, scaled
 
 __all__ = ["plot_depth_sweep", "plot_hologram", "plot_image", "plot_planes", "plot_section",
            "plot_spectrum", "to_png"]
-
-
-def to_png(fig: Figure, dpi: int = 110) -> bytes:
-    """Render a figure to PNG bytes."""
-    FigureCanvasAgg(fig)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    return buf.getvalue()
-
-
-def _edges(c: np.ndarray) -> np.ndarray:
-    c = np.asarray(c, float)
-    if c.size == 1:
-        return np.array([c[0] - 0.5, c[0] + 0.5])
-    mid = 0.5 * (c[1:] + c[:-1])
-    return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
 
 
 def plot_hologram(h: Hologram, title: str = "Hologram") -> Figure:

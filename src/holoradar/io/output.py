@@ -8,7 +8,7 @@ import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-__all__ = ["check_output", "default_mode", "write_via_temp"]
+__all__ = ["check_output", "default_mode", "write_atomic", "write_via_temp"]
 
 
 def default_mode() -> int:
@@ -99,6 +99,19 @@ def write_via_temp(target: Path, write: Callable[[Path], None]) -> Path:
         tmp_path.unlink(missing_ok=True)
         raise
     return target
+
+
+def write_atomic(path: str | os.PathLike[str], payload: bytes) -> Path:
+    """Write ``payload`` to ``path`` so that readers see the old file or the new one, never half.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> write_atomic(d / "a.txt", b"hi").read_bytes()
+    b'hi'
+    """
+    return write_via_temp(Path(path), lambda tmp: tmp.write_bytes(payload))
 
 
 def _identity(path: str | os.PathLike[str]) -> tuple[int, int] | None:

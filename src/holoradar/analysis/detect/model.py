@@ -36,6 +36,7 @@ from ...data.hologram import Hologram
 from ...imaging.migrate import _data_snr, _weights, migrate
 from ...imaging.point_response import PointResponse
 from ...physics.medium import Medium
+from .errors import HologramFitError
 from .grid import Volume
 from .kimage import SpectralSum
 
@@ -83,23 +84,25 @@ class HologramModel:
     def __init__(self, hologram: Hologram, volume: Volume, medium: Medium | None,
                  options: dict[str, Any] | None = None) -> None:
         if not isinstance(hologram, Hologram):
-            raise ValueError("hologram must be a holoradar.Hologram, got "
-                             f"{type(hologram).__name__}")
+            raise HologramFitError("hologram must be a holoradar.Hologram, got "
+                                   f"{type(hologram).__name__}", "type")
         shape = hologram.data.shape
         if len(shape) != (3 if hologram.is_wideband else 2):
-            raise ValueError("hologram must hold one frame (ny, nx) or (nf, ny, nx); got shape "
-                             f"{shape}: select the frame the image was made from")
+            raise HologramFitError("hologram must hold one frame (ny, nx) or (nf, ny, nx); got "
+                                   f"shape {shape}: select the frame the image was made from",
+                                   "frames")
         if not np.allclose(hologram.points[:, 2], 0.0) or hologram.pose.normal[2] < 1 - 1e-12:
-            raise ValueError("hologram must lie on a level aperture at z = 0 (identity pose) "
-                             "for detect's point fit; tilted arrays are not supported yet")
+            raise HologramFitError("hologram must lie on a level aperture at z = 0 (identity "
+                                   "pose) for detect's point fit; tilted arrays are not "
+                                   "supported yet", "tilted")
         dx = hologram.pitch[0]
         u = round(dx / volume.dx)
         expect_x = hologram.x[0] + np.arange(u * (hologram.x.size - 1) + 1) * dx / u
         if u < 1 or expect_x.size != volume.x.size or not np.allclose(expect_x, volume.x,
                                                                       atol=1e-9 + 1e-6 * dx):
-            raise ValueError("image does not come from hologram: its x grid is not the "
-                             "elements' at an integer upsampling (migrate(..., upsample=u), "
-                             "fov='aperture')")
+            raise HologramFitError("image does not come from hologram: its x grid is not the "
+                                   "elements' at an integer upsampling (migrate(..., "
+                                   "upsample=u), fov='aperture')", "grid")
         self.hologram = hologram
         self.vol = volume
         self.medium = medium
@@ -166,10 +169,11 @@ class HologramModel:
         ref = self.vol.data if self.vol.planar else self.vol.data[planes]
         err = float(np.max(np.abs(img - ref))) / scale
         if not err < 1e-5:
-            raise ValueError("image is not migrate(hologram, image.z, medium=medium, "
-                             f"upsample={self.options['upsample']}) (they differ by {err:.2g} of "
-                             "the peak); pass the migration's other options as "
-                             "migrate_options={...}, or leave hologram out")
+            raise HologramFitError("image is not migrate(hologram, image.z, medium=medium, "
+                                   f"upsample={self.options['upsample']}) (they differ by "
+                                   f"{err:.2g} of the peak); pass the migration's other "
+                                   "options as migrate_options={...}, or leave hologram out",
+                                   "mismatch", err)
         self._sum = self._spectral_sum(img, planes, scale)
         return self.vol.data.copy()
 

@@ -3,17 +3,19 @@ the ground from flags or a TOML file, depth ranges, safe outputs."""
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import math
-import re
-import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import click
 import numpy as np
+
+from ...data import range_checks
+from ...data.range_checks import RangeError, array_of, scaled, warn_above_ground
 
 __all__ = ["Reporter", "array_of", "check_ground", "check_planes", "check_ranges", "depth_ranges",
            "input_history", "layout_option", "medium_from_options", "medium_options",
@@ -57,28 +59,12 @@ class Reporter:
             (default: all of ``lines``, for commands whose every line is the answer).
         """
         if self.as_json:
-            click.echo(json.dumps(_plain(summary), indent=2))
+            from ...io.plain import plain
+
+            click.echo(json.dumps(plain(summary), indent=2))
             return
         for text in (lines if not self.quiet or result is None else result):
             click.echo(text)
-
-
-def _plain(v: Any) -> Any:
-    if isinstance(v, dict):
-        return {str(k): _plain(e) for k, e in v.items()}
-    if isinstance(v, list | tuple):
-        return [_plain(e) for e in v]
-    if isinstance(v, np.ndarray):
-        return _plain(v.tolist())
-    if isinstance(v, complex | np.complexfloating):
-        return {"re": float(v.real), "im": float(v.imag)}
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, Path):
-        return str(v)
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
 
 def output_options(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -115,14 +101,11 @@ def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
 
 
 def read_hologram(path: Path, layout: str | None, check: bool) -> Any:
-    """A hologram from any supported file; an image file is refused by name."""
-    from ...data.hologram import Hologram
-    from ...io import load
+    """A hologram from any supported file; an image file is refused by name
+    (:func:`holoradar.io.inputs.read_hologram`)."""
+    from ...io.inputs import read_hologram as read
 
-    obj = load(path, layout=layout, check=check)
-    if not isinstance(obj, Hologram):
-        raise ValueError(f"{path.name} holds an image, not a hologram")
-    return obj
+    return read(path, layout, check)
 
 
 def input_history(path: Path, layout: str | None) -> list[dict[str, Any]]:
@@ -276,132 +259,45 @@ def triple(text: str, name: str) -> tuple[float, float, float]:
 
 
 # --- ranges against the array: a unit slip in an option is refused like one in a file ----
+# (the checks are the library's, holoradar.data.range_checks; here their refusals become
+# click errors of the option they name)
 
-def array_of(holo: Any) -> tuple[float, float]:
-    """The larger full width (n * pitch, m) and the highest frequency (Hz) of a hologram's
-    array (of an image: of its pixels, which span the array)."""
-
-    def width(v: np.ndarray) -> float:
-        v = np.asarray(v, dtype=float)
-        return float(np.ptp(v) * v.size / (v.size - 1)) if v.size > 1 else 0.0
-
-    return max(width(holo.x), width(holo.y)), float(np.max(holo.frequency))
-
-
-def scaled(text: str, factor: float) -> str:
-    """An option's numbers divided by a unit factor: ``35:55:0.5`` / 100 is
-    ``0.35:0.55:0.005`` (the form a user should have typed)."""
-    return "".join(p if p in (":", ",") else f"{float(p) / factor:.6g}"
-                   for p in re.split(r"([:,])", text.strip()))
+@contextlib.contextmanager
+def _option_error() -> Iterator[None]:
+    try:
+        yield
+    except RangeError as exc:
+        raise click.BadParameter(str(exc), param_hint=exc.name) from None
 
 
 def check_ranges(ranges: Any, text: str, name: str, aperture: float, frequency: float,
                  medium: Any = None, *, what: str | None = None, offset: float = 0.0,
                  escape: str | None = "--no-check") -> None:
-    """Refuse ranges that no array of this width can focus (most likely centimetres or
-    millimetres typed for metres), naming the option and the metres meant.
-
-    Parameters
-    ----------
-    ranges : float or array_like
-        The ranges from the array plane the option asks for, metres.
-    text : str
-        The option's value as typed (for the corrected example).
-    name : str
-        The option, e.g. ``"--z"``.
-    aperture, frequency : float
-        The array's larger width (m) and highest frequency (Hz).
-    medium : Medium, optional
-        The ground: ranges below it are judged by their apparent range.
-    what : str, optional
-        How the message names the ranges (default their span in metres).
-    offset : float, optional
-        The surface's range, for values that are depths below it.
-    escape : str or None
-        The flag that skips the check, named in the message.
-
-    Raises
-    ------
-    click.BadParameter
-    """
-    from ...data.plausibility import range_problem, unit_slip
-
-    problem = range_problem(ranges, aperture, frequency, medium, what, offset)
-    if problem is None:
-        return
-    factor = unit_slip(ranges, aperture, frequency, medium, offset)
-    raise click.BadParameter(problem + _advice(
-        None if factor is None else f"{name} {scaled(text, factor)}", escape), param_hint=name)
-
-
-def _advice(example: str | None, escape: str | None) -> str:
-    """The way out of a refusal: the metres meant, and the flag that skips the check."""
-    parts = ([f"give metres, e.g. {example}"] if example else []) + \
-        ([f"{escape} takes the value as given"] if escape else [])
-    return f" ({'; '.join(parts)})" if parts else ""
-
-
-def _ground_flag(spec: dict[str, Any]) -> str:
-    return ("--medium" if spec.get("medium_file") is not None else
-            "--layers" if spec.get("layers") is not None else "--z-surface")
+    """:func:`holoradar.data.range_checks.check_ranges`; its refusal is a
+    ``click.BadParameter`` of the option ``name``."""
+    with _option_error():
+        range_checks.check_ranges(ranges, text, name, aperture, frequency, medium, what=what,
+                                  offset=offset, escape=escape)
 
 
 def check_ground(medium: Any, spec: dict[str, Any], aperture: float, frequency: float, *,
                  escape: str | None = "--no-check") -> None:
-    """Refuse a ground whose surface or layers lie where the array focuses nothing
-    (``--z-surface 30`` for 30 cm), naming the flag that gave it."""
-    if medium is None or medium.is_free_space:
-        return
-    name = _ground_flag(spec)
-    deepest = float(medium.z_interfaces[-1])
-    if name == "--z-surface":
-        check_ranges(deepest, f"{deepest:g}", name, aperture, frequency, medium,
-                     what=f"a ground surface {deepest:.4g} m", escape=escape)
-        return
-    from ...data.plausibility import range_problem
-
-    problem = range_problem(deepest, aperture, frequency, medium,
-                            f"a layer top at {deepest:.4g} m")
-    if problem is not None:
-        raise click.BadParameter(problem + _advice(None, escape), param_hint=name)
-
-
-def warn_above_ground(planes: Any, medium: Any, spec: dict[str, Any], name: str = "--z") -> None:
-    """Warn when every plane lies in the air above the ground: it can be meant (looking
-    at something above the surface), but the ground then plays no part."""
-    if medium is None or medium.is_free_space:
-        return
-    z = np.atleast_1d(np.asarray(planes, dtype=float))
-    surface = float(medium.z_interfaces[0])
-    if z.max() < surface:
-        from ...data.plausibility import PlausibilityWarning, _span
-
-        warnings.warn(f"every plane of {name} ({_span(z)} m) lies above the ground surface "
-                      f"at {surface:.4g} m ({_ground_flag(spec)}): the image is in air and "
-                      "the ground plays no part", PlausibilityWarning, stacklevel=2)
+    """:func:`holoradar.data.range_checks.check_ground`; its refusal is a
+    ``click.BadParameter`` of the ground flag that gave the ground."""
+    with _option_error():
+        range_checks.check_ground(medium, spec, aperture, frequency, escape=escape)
 
 
 def check_planes(holo: Any, zs: Any, text: str, medium: Any, spec: dict[str, Any],
                  check: bool, name: str = "--z") -> None:
-    """The checks of an imaging command's ranges and ground against the hologram's array:
-    :func:`check_ranges`, :func:`check_ground`, :func:`warn_above_ground` (none with
-    ``--no-check``)."""
-    if not check:
-        return
-    aperture, frequency = array_of(holo)
-    check_ranges(zs, text, name, aperture, frequency, medium)
-    check_ground(medium, spec, aperture, frequency)
-    warn_above_ground(zs, medium, spec, name)
+    """:func:`holoradar.data.range_checks.check_planes`; its refusals are
+    ``click.BadParameter`` of the option that gave the value."""
+    with _option_error():
+        range_checks.check_planes(holo, zs, text, medium, spec, check, name)
 
 
 def refuse_outside_planes(value: float, planes: Any, name: str, what: str) -> None:
-    """Refuse a range outside the planes a file or store holds (the nearest plane would
-    be taken silently), naming the likely unit slip and the metres meant."""
-    from ...data.plausibility import plane_problem
-
-    problem = plane_problem(value, planes, what)
-    if problem is None:
-        return
-    reason, factor = problem
-    raise click.BadParameter(reason + _advice(
-        f"{name} {value / factor:.6g}" if factor != 1.0 else None, None), param_hint=name)
+    """:func:`holoradar.data.range_checks.refuse_outside_planes`; its refusal is a
+    ``click.BadParameter`` of the option ``name``."""
+    with _option_error():
+        range_checks.refuse_outside_planes(value, planes, name, what)

@@ -70,7 +70,7 @@ def report(files: tuple[Path, ...], out: Path, z: str | None, medium_spec: dict[
     processing history and the warnings; -o names it (.html).
     """
     from ...io.output import check_output
-    from ..report import report as write_report
+    from ...reporting import report as write_report
     from .common import depth_ranges
     from .detect import _eps_interval, _false_alarm, _kinds
 

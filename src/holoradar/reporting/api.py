@@ -24,7 +24,7 @@ def _sources(sources: Any) -> list[Any]:
 
 
 def _interval(eps_interval: Any, name: str) -> tuple[tuple[float, float] | None, str]:
-    from ...analysis.detect.table import as_eps_interval
+    from ..analysis.detect.table import as_eps_interval
 
     if eps_interval is None:
         return None, ""
@@ -142,9 +142,8 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
     >>> summary["n_objects"], out.read_text().startswith("<!DOCTYPE html>")
     (1, True)
     """
-    from ..._version import __version__
-    from ...io.output import check_output
-    from ..atomic import write_atomic
+    from .._version import __version__
+    from ..io.output import check_output, write_atomic
     from .figures import pictures
     from .html import page
 

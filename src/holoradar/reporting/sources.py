@@ -2,9 +2,10 @@
 turned into a :class:`~.model.Section`: read, its ground found, its objects detected,
 the warnings raised on the way kept.
 
-The detection is ``holoradar detect``'s (``holoradar.app.cli.detect``): the same
-readings of a file, the same ground from an image's history, the same fit with the
-hologram and the same survey gathering, so that the report's table is the one
+The detection is ``holoradar detect``'s: the same readings of a file
+(:mod:`holoradar.io.inputs`), the same ground from an image's history, the same fit
+with the hologram (:mod:`holoradar.analysis.detect.sources`) and the same survey
+gathering (:mod:`holoradar.survey.detect`), so that the report's table is the one
 ``holoradar detect`` writes for the same file and options.
 """
 
@@ -69,15 +70,6 @@ class Request:
     check: bool = True
 
 
-class _Silent:
-    """The part of the command line's Reporter the survey's gathering uses: nothing shown."""
-
-    progress = False
-
-    def line(self, text: str) -> None:
-        """Say nothing."""
-
-
 def _name(source: Any, index: int) -> str:
     if isinstance(source, str | os.PathLike):
         return Path(source).name or str(source)
@@ -130,7 +122,7 @@ def build_section(source: Any, index: int, req: Request, *, hologram: Any = None
 
 
 def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any) -> Section:
-    from ...data.hologram import Hologram, Image
+    from ..data.hologram import Hologram, Image
 
     n = req.names
     name = _name(source, index)
@@ -140,7 +132,7 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
             raise ValueError(f"{n['sources']}: {str(path)!r} does not exist")
         if path.is_dir():
             return _store_section(path, name, req, hologram, detections)
-        from ...io import load
+        from ..io import load
 
         obj = load(path, layout=req.layout, check=req.check)
         attrs = file_attributes(path)
@@ -171,11 +163,11 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
 
 def _read_hologram(hologram: Any, req: Request) -> tuple[Any, dict[str, Any]]:
     """The hologram an image was imaged from, and its file's attributes."""
-    from ...data.hologram import Hologram
+    from ..data.hologram import Hologram
 
     if isinstance(hologram, Hologram):
         return hologram, {}
-    from ..cli.common import read_hologram
+    from ..io.inputs import read_hologram
 
     try:
         holo = read_hologram(Path(hologram), req.layout, req.check)
@@ -185,14 +177,14 @@ def _read_hologram(hologram: Any, req: Request) -> tuple[Any, dict[str, Any]]:
 
 
 def _ground(req: Request, obj: Any, path: Path | None) -> Ground:
-    from ...data.hologram import Image
+    from ..data.hologram import Image
 
     n = req.names
     medium, how = req.medium, f"given as {n['medium']}"
     if medium is None and isinstance(obj, Image) and path is not None:
-        from ..cli.detect import _history_medium
+        from ..io.inputs import history_medium
 
-        medium = _history_medium(path)
+        medium = history_medium(path)
         how = "the image's history: the ground it was imaged through"
     if medium is None:
         how = "none: free space (ranges from the array, no depths)"
@@ -218,7 +210,7 @@ def _one_plane(z: Any, planes: np.ndarray, req: Request, name: str) -> float:
 
 def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: Request,
                    hologram: Any, detections: Any) -> tuple[Any, Any]:
-    from ..cli.detect import _detect, _fit, _level, _options_of
+    from ..analysis.detect.sources import detect_quietly, fit_hologram, options_of
 
     n = req.names
     planes = np.atleast_1d(np.asarray(img.z, dtype=float))
@@ -229,13 +221,9 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
                              "plane, from the image alone), not both")
         if detections is not None:
             return img, detections
-        holo = hologram
-        fit_medium = medium
-        if holo.pose.is_level:
-            holo, fit_medium = _level(holo, medium)
-        return img, _fit(img, holo, fit_medium, _options_of(img), args, n["hologram"],
-                         f"give the hologram {name} was imaged from, or {n['z']} to search "
-                         "one plane from the image alone")
+        return img, fit_hologram(img, hologram, medium, options_of(img), args, n["hologram"],
+                                 f"give the hologram {name} was imaged from, or {n['z']} to "
+                                 "search one plane from the image alone")
     if req.z is not None:
         plane = _one_plane(req.z, planes, req, name)
         img = img.plane(plane) if img.has_z_axis else img
@@ -245,13 +233,13 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
                          "(one plane, from the image alone)")
     if detections is not None:
         return img, detections
-    return img, _detect(img, medium=medium, **args)
+    return img, detect_quietly(img, medium=medium, **args)
 
 
 def _hologram_objects(holo: Any, name: str, medium: Any, args: dict[str, Any], req: Request,
                       detections: Any) -> tuple[Any, Any]:
-    from ...imaging.migrate import migrate
-    from ..cli.detect import _fit, _level
+    from ..analysis.detect.sources import fit_hologram
+    from ..imaging.migrate import migrate
 
     n = req.names
     if req.z is None:
@@ -262,31 +250,25 @@ def _hologram_objects(holo: Any, name: str, medium: Any, args: dict[str, Any], r
         raise ValueError(f"{n['z']}: expected ranges in metres (>= 0), got {req.z!r}")
     if req.check:
         # holoradar detect's checks of ranges against the array (a unit slip is refused)
-        import click
-
-        from ..cli.common import check_planes
+        from ..data.range_checks import RangeError, check_planes
 
         try:
             check_planes(holo, zs, ",".join(f"{v:g}" for v in zs), medium, {}, True,
                          name=n["z"])
-        except click.BadParameter as exc:
-            raise ValueError(f"{exc.param_hint or n['z']}: {exc.message}") from None
+        except RangeError as exc:
+            raise ValueError(f"{exc.name or n['z']}: {exc}") from None
     img = migrate(holo, zs, medium=medium, upsample=4)
     if detections is not None:
         return img, detections
-    fit_medium = medium
-    if holo.pose.is_level:
-        holo, fit_medium = _level(holo, medium)
-    return img, _fit(img, holo, fit_medium, {}, args, name,
-                     f"image it first and report the image with {n['z']} (one plane)")
+    return img, fit_hologram(img, holo, medium, {}, args, name,
+                             f"image it first and report the image with {n['z']} (one plane)")
 
 
 def _store_section(path: Path, name: str, req: Request, hologram: Any,
                    detections: Any) -> Section:
-    import click
-
-    from ...survey.store import is_survey, stored_settings
-    from ..cli.detect import _from_store
+    from ..analysis.detect.errors import DetectionInputError
+    from ..survey.detect import from_store
+    from ..survey.store import is_survey, stored_settings
 
     n = req.names
     if not is_survey(path):
@@ -308,22 +290,12 @@ def _store_section(path: Path, name: str, req: Request, hologram: Any,
     if detections is not None:
         table = detections
     else:
-        z_text = None
-        if req.z is not None:
-            zs = np.atleast_1d(np.asarray(req.z, dtype=float))
-            if zs.size != 1:
-                raise ValueError(f"{n['z']}: expected one range in metres (the stored plane "
-                                 f"to search), got {req.z!r}")
-            z_text = repr(float(zs[0]))
-        spec = dict.fromkeys(("eps", "z_surface", "layers", "medium_file", "tan_delta",
-                              "sigma"))
         try:
-            table, info, _ = _from_store(path, z_text, spec, {
+            table, info, _ = from_store(path, _stored_plane(req), {
                 "false_alarm": req.false_alarm, "kinds": req.kinds,
-                "eps_interval": req.eps_interval}, _Silent())
-        except click.BadParameter as exc:
-            hint = n["z"] if exc.param_hint == "--z" else str(exc.param_hint or n["sources"])
-            raise ValueError(f"{hint}: {exc.message}") from None
+                "eps_interval": req.eps_interval})
+        except DetectionInputError as exc:
+            raise ValueError(f"{n['z'] if exc.name == 'z' else n['sources']}: {exc}") from None
     detection = _detection(table, req)
     if info:
         detection.update({"frames": info.get("frames"), "model": info.get("model"),
@@ -333,8 +305,26 @@ def _store_section(path: Path, name: str, req: Request, hologram: Any,
                    store=str(path))
 
 
+def _stored_plane(req: Request) -> float | None:
+    """The one stored plane to search (m), or None: every frame fitted to its hologram."""
+    if req.z is None:
+        return None
+    n = req.names
+    zs = np.atleast_1d(np.asarray(req.z, dtype=float))
+    if zs.size != 1:
+        raise ValueError(f"{n['z']}: expected one range in metres (the stored plane to "
+                         f"search), got {req.z!r}")
+    plane = float(zs[0])
+    if not math.isfinite(plane):
+        # as the command line's --z text it would be ('nan', 'inf')
+        text = repr(plane)
+        raise ValueError(f"{n['z']}: expected a range in metres or start:stop:step, got "
+                         f"{text!r}")
+    return plane
+
+
 def _store_history(path: Path) -> list[dict[str, Any]]:
-    from ...survey.store import read_index, stored_settings
+    from ..survey.store import read_index, stored_settings
 
     idx = read_index(path)
     settings = stored_settings(path)[0].to_dict()

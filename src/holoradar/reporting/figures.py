@@ -22,7 +22,8 @@ from matplotlib import patheffects
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from ..plotting import _edges, to_png
+from .._figures import edges as _edges
+from .._figures import to_png
 from .model import Section
 
 __all__ = ["DB_RANGE", "MAX_PLANES", "Picture", "pictures"]
@@ -255,8 +256,8 @@ def pictures(section: Section) -> list[Picture]:
 
 
 def _survey_pictures(section: Section, cell: float) -> list[Picture]:
-    from ...survey.mosaic import mosaic
-    from ...survey.store import read_index
+    from ..survey.mosaic import mosaic
+    from ..survey.store import read_index
 
     table = section.table
     planes = np.asarray(read_index(Path(section.store))["z"], dtype=float)

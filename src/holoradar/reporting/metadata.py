@@ -131,7 +131,7 @@ def device_rows(obj: Any, attrs: dict[str, Any]) -> list[tuple[str, str]]:
     >>> rows["array"], rows["frequency"]
     ('16 x 16 elements at 1.25 x 1.25 cm pitch (20 x 20 cm)', '9.9 GHz')
     """
-    from ...data.hologram import Image
+    from ..data.hologram import Image
 
     rows: list[tuple[str, str]] = []
     nx, sx = _axis(obj.x)
@@ -171,7 +171,7 @@ def device_rows(obj: Any, attrs: dict[str, Any]) -> list[tuple[str, str]]:
 
 def store_rows(store: Path) -> list[tuple[str, str]]:
     """A survey store's settings and frames as (label, value) rows."""
-    from ...survey.store import describe_store
+    from ..survey.store import describe_store
 
     d = describe_store(store)
     s, g = d["settings"], d["geometry"]

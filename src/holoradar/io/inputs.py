@@ -1,0 +1,53 @@
+"""Inputs read as the commands and the report read them: a hologram file (an image
+refused by name), and the ground an image file was imaged through (its history)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+__all__ = ["history_medium", "read_hologram"]
+
+
+def read_hologram(path: Path, layout: Any, check: bool) -> Any:
+    """A hologram from any supported file (:func:`holoradar.load`).
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read, or it holds an image (named: ``"NAME holds an image,
+        not a hologram"``).
+    """
+    from ..data.hologram import Hologram
+    from . import load
+
+    obj = load(path, layout=layout, check=check)
+    if not isinstance(obj, Hologram):
+        raise ValueError(f"{path.name} holds an image, not a hologram")
+    return obj
+
+
+def history_medium(path: Path) -> Any:
+    """The ground a holoradar image file was made through: the medium of the last
+    ``migrate`` step of its history; None for another file, a file without that step
+    or a step imaged in free space (anything unreadable is None too)."""
+    from ..physics.medium import Medium
+    from .netcdf import read_history
+
+    if path.suffix.lower() not in (".nc", ".nc4"):
+        return None
+    try:
+        steps = read_history(path)
+    except (ValueError, OSError):
+        return None
+    for step in reversed(steps):
+        if isinstance(step, dict) and step.get("step") == "migrate":
+            g = (step.get("parameters") or {}).get("medium")
+            if not g:
+                return None
+            try:
+                return Medium(tuple(float(z) for z in g["z_interfaces"]),
+                              tuple(complex(str(e).replace(" ", "")) for e in g["eps"]))
+            except (KeyError, TypeError, ValueError):
+                return None
+    return None
