@@ -14,7 +14,8 @@ import pytest
 
 import holoradar as hr
 from holoradar.imaging import columns, kspace
-from holoradar.imaging import migrate as migrate_module
+from holoradar.imaging.migration import memory
+from holoradar.imaging.migration import plan as migration_plan
 
 FREQS = np.linspace(8e9, 12e9, 11)
 ZS = np.linspace(0.16, 0.30, 29)
@@ -77,8 +78,8 @@ def test_auto_equals_the_phase_shift_sum_on_every_grid(pad, upsample, z0):
 def test_auto_takes_the_compiled_loop_and_the_numpy_sum_without_numba(monkeypatch):
     h = _hologram(True, None, False, np.complex128)
     calls = []
-    real = columns.migrate_columns
-    monkeypatch.setattr(columns, "migrate_columns",
+    real = columns.adjoint_columns
+    monkeypatch.setattr(columns, "adjoint_columns",
                         lambda *a, **k: calls.append(1) or real(*a, **k))
     a = hr.migrate(h, ZS)
     assert calls == [1]
@@ -123,12 +124,14 @@ def test_auto_falls_back_to_the_per_frequency_sum_where_the_phase_shift_cannot()
 def test_a_volume_that_does_not_fit_is_refused_before_any_work(monkeypatch):
     h = _hologram(True, None, False, np.complex128)
     work = []
-    for mod, name in ((columns, "migrate_columns"), (kspace, "migrate_kspace"),
-                      (migrate_module, "_data_snr")):
-        monkeypatch.setattr(mod, name, lambda *a, **k: work.append(1))
+    for mod, name in ((columns, "adjoint_columns"), (kspace, "adjoint_kspace"),
+                      (migration_plan, "data_snr")):
+        real = getattr(mod, name)
+        monkeypatch.setattr(mod, name,
+                            lambda *a, real=real, **k: work.append(1) or real(*a, **k))
     # 29 planes of 24 x 24 complex128: 0.13 MB; 1.5 x that needs more than 0.15 MB.
-    monkeypatch.setattr(migrate_module, "available_memory", lambda: 150_000)
-    monkeypatch.setattr(migrate_module, "_CHECK_ABOVE", 0)   # checked at any size
+    monkeypatch.setattr(memory, "available_memory", lambda: 150_000)
+    monkeypatch.setattr(memory, "_CHECK_ABOVE", 0)   # checked at any size
     with pytest.raises(MemoryError) as err:
         hr.migrate(h, ZS)
     msg = str(err.value)
@@ -141,6 +144,6 @@ def test_a_volume_that_does_not_fit_is_refused_before_any_work(monkeypatch):
         hr.migrate(h.at_frequency(0), ZS)
     assert work == []
     # Enough memory: it runs (the stand-ins record the work).
-    monkeypatch.setattr(migrate_module, "available_memory", lambda: 10**9)
+    monkeypatch.setattr(memory, "available_memory", lambda: 10**9)
     hr.migrate(h, ZS)
     assert work and work[-1] == 1

@@ -12,7 +12,7 @@ import pytest
 import scipy.fft as sfft
 
 import holoradar as hr
-from holoradar.imaging import migrate as migrate_module
+from holoradar.imaging.migration import planes as planes_module
 from holoradar.physics.propagation import AngularSpectrum
 
 F0 = 9.9e9
@@ -96,11 +96,11 @@ def test_grazing_component_is_out_of_band_in_the_phase_step_too(dtype):
 
 @pytest.mark.parametrize("threshold", [0, 1 << 40])   # always threads / never threads
 def test_plane_products_are_exact_in_one_thread_or_many(monkeypatch, threshold):
-    monkeypatch.setattr(migrate_module, "_THREADED_MULTIPLY", threshold)
+    monkeypatch.setattr(planes_module, "_THREADED_MULTIPLY", threshold)
     H = _field((2, 70, 33), np.complex64, seed=2)
     Us = [_field((70, 33), np.complex64, seed=3 + i) for i in range(3)]
     prod = np.empty((2, 3, 70, 33), np.complex64)
-    migrate_module._multiply_planes(H, Us, prod)
+    planes_module.multiply_planes(H, Us, prod)
     for i, U in enumerate(Us):
         np.testing.assert_array_equal(prod[:, i], H * U)
 
@@ -110,6 +110,6 @@ def test_volume_in_one_thread_equals_the_threaded_volume(monkeypatch):
     h = hr.Hologram(a, np.arange(64) * DX, np.arange(64) * DX, F0)
     zs = np.linspace(0.2, 0.5, 12)
     one = hr.migrate(h, zs, pad=False, algorithm="frequency").data
-    monkeypatch.setattr(migrate_module, "_THREADED_MULTIPLY", 0)
+    monkeypatch.setattr(planes_module, "_THREADED_MULTIPLY", 0)
     many = hr.migrate(h, zs, pad=False, algorithm="frequency").data
     np.testing.assert_array_equal(one, many)

@@ -15,10 +15,21 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from holoradar.imaging.oblique import sum_to_plane
 from holoradar.physics.green import layered_green
 from holoradar.theory import range_resolution
 
 F0 = 9.9e9
+
+
+def _spectrum_on_plane(h: hr.Hologram, grid, pitch, origin, work, *, gap: float,
+                       route: str = "auto") -> np.ndarray:
+    """The ground frame's spectrum sum of every frame of ``h`` (its own wavenumber, the
+    round trip's for a transceiver), shaped (..., My, Mx)."""
+    kk = 2 * h.k if h.monostatic else h.k
+    d = h.data.reshape(-1, *h.data.shape[-2:])
+    H = sum_to_plane(h, d, kk, grid, pitch, origin, np.dtype(work), gap, route)
+    return H.reshape((*h.data.shape[:-2], *grid))
 K0 = 2 * np.pi * F0 / hr.C0
 DATA = Path(__file__).parent / "data"
 
@@ -97,8 +108,6 @@ def test_level_aperture_spectrum_is_the_fft_of_the_data():
     world grid, is the zero-padded FFT of the data (what the frontal migration
     transforms): equal to rounding, 1e-12 of the largest value; everything after
     it is the frontal pipeline (same transfer functions)."""
-    from holoradar.imaging.oblique import _spectrum_on_plane
-
     rng = np.random.default_rng(3)
     x = (np.arange(12) - 5.5) * 0.015
     y = (np.arange(10) - 4.5) * 0.015
@@ -246,8 +255,6 @@ def test_spectrum_on_the_reference_plane_is_the_direct_sum(azimuth_deg):
     full, depending on the pose) equals the direct sum over the elements,
     H(k) = sum_e d_e exp(-i [p (x_e - x0) + q (y_e - y0) + conj(kz) (z_ref - z_e)]),
     to rounding (1e-12 of the largest value)."""
-    from holoradar.imaging.oblique import _spectrum_on_plane
-
     rng = np.random.default_rng(1)
     x = (np.arange(10) - 4.5) * 0.015
     y = (np.arange(8) - 3.5) * 0.015

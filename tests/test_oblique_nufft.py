@@ -17,10 +17,20 @@ import pytest
 
 import holoradar as hr
 from holoradar.imaging import oblique
-from holoradar.imaging.oblique import _spectrum_on_plane, choose_route
+from holoradar.imaging.oblique import choose_route
 from holoradar.imaging.oblique_nufft import EPS
 
 F0 = 9.9e9
+
+
+def _spectrum_on_plane(h: hr.Hologram, grid, pitch, origin, work, *, gap: float,
+                       route: str = "auto") -> np.ndarray:
+    """The ground frame's spectrum sum of every frame of ``h`` (its own wavenumber, the
+    round trip's for a transceiver), shaped (..., My, Mx)."""
+    kk = 2 * h.k if h.monostatic else h.k
+    d = h.data.reshape(-1, *h.data.shape[-2:])
+    H = oblique.sum_to_plane(h, d, kk, grid, pitch, origin, np.dtype(work), gap, route)
+    return H.reshape((*h.data.shape[:-2], *grid))
 
 
 def _rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -116,13 +126,15 @@ def test_migrate_ground_takes_the_route_it_is_given():
     pose = hr.Pose((0.0, -0.05, 0.05), tilt=np.radians(35), azimuth=np.radians(90))
     h = hr.Hologram(d, x, x, F0, pose=pose)
     sand = hr.Medium.half_space(0.3, 2.5 + 0.05j)
-    zs = np.array([0.4])
-    images = {r: oblique.migrate_ground(h, zs, sand, route=r).data
-              for r in ("auto", "direct", "nufft")}
+    images = {r: hr.migrate(h, [0.4], medium=sand, frame="ground", algorithm=r).data
+              for r in ("auto", "ground-direct", "ground-nufft")}
     # the default is one of the two, bit for bit (which one: the test above)
-    assert sum(np.array_equal(images["auto"], images[r]) for r in ("direct", "nufft")) == 1
-    with pytest.raises(ValueError, match="route must be 'auto', 'nufft' or 'direct'"):
-        oblique.migrate_ground(h, zs, sand, route="fast")
+    assert sum(np.array_equal(images["auto"], images[r])
+               for r in ("ground-direct", "ground-nufft")) == 1
+    with pytest.raises(ValueError, match="algorithm must be 'auto'"):
+        hr.migrate(h, [0.4], medium=sand, frame="ground", algorithm="fast")
+    with pytest.raises(ValueError, match="algorithm='ground-nufft' needs frame='ground'"):
+        hr.migrate(h.replace(pose=None), [0.4], medium=sand, algorithm="ground-nufft")
 
 
 def test_elements_off_a_uniform_grid_take_the_direct_sums():

@@ -241,18 +241,25 @@ def test_normal_plane_wave_phasor_is_one_pixel_broadcast_exactly(medium):
     # A normal plane wave's incident phase is the same across a plane (its lateral
     # factor is exactly 1), so the frequencies' sum takes it on one pixel per plane
     # and broadcasts it: it must equal the phasor computed at every pixel, bit for bit.
-    from holoradar.imaging.migrate import _incident_phasor
+    from holoradar.imaging.migration import illumination
+    from holoradar.imaging.migration.plan import make_plan
     from holoradar.physics.incident import incident_phasors
 
     med = medium if medium is not None else hr.Medium.free_space()
     x = np.linspace(-0.2, 0.2, 21)
-    img = hr.Image(np.zeros((3, 21, 21), complex), x, x, np.array([0.1, 0.25, 0.4]), 9.9e9,
-                   "angular", has_z_axis=True)
+    zs = np.array([0.1, 0.25, 0.4])
+    h = hr.Hologram(np.ones((2, 21, 21)), x, x, [9.9e9, 10e9], source=hr.PlaneWave())
+    plan = make_plan(h, zs, medium, hr.MigrationSettings())
     k = 2 * np.pi * 9.9e9 / hr.C0
-    got = _incident_phasor(None, k, med, img)
-    full = incident_phasors([hr.PlaneWave()], k, med, img.x, img.y, img.z)[0]
+    got = illumination.on_planes(plan, 0, x, x)
+    full = incident_phasors([hr.PlaneWave()], k, med, x, x, zs)[0]
     assert got.shape == full.shape
     np.testing.assert_array_equal(got, full)
+    # the per-plane values the band's summed spectra use are the same numbers
+    np.testing.assert_array_equal(illumination.uniform(plan, 0), full[:, 0, 0])
     # a tilted wave is not uniform: computed at every pixel
-    tilted = _incident_phasor(hr.PlaneWave(0.2, 0.0), k, med, img)
-    assert not np.allclose(tilted[0], tilted[0, 0, 0])
+    tilted = make_plan(h.replace(source=hr.PlaneWave(0.2, 0.0)), zs, medium,
+                       hr.MigrationSettings())
+    assert not illumination.is_uniform(tilted)
+    phasor = illumination.on_planes(tilted, 0, x, x)
+    assert not np.allclose(phasor[0], phasor[0, 0, 0])

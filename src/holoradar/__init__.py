@@ -36,6 +36,8 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     )
     from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
     from .imaging.migrate import IlluminationWarning, migrate
+    from .imaging.migration.linear import MigrationOperator, migration_operator
+    from .imaging.migration.settings import MigrationSettings
     from .imaging.stream import StreamImager
     from .imaging.synthesis import align_phases, synthesize
     from .io import load, save
@@ -70,6 +72,8 @@ _NAMES = {
     "IlluminationWarning": ".imaging.migrate",
     "Image": ".data.hologram",
     "LineTarget": ".model.targets",
+    "MigrationOperator": ".imaging.migration.linear",
+    "MigrationSettings": ".imaging.migration.settings",
     "Medium": ".physics.medium",
     "ObliquePlan": ".analysis.oblique_plan",
     "ParabolicEquation": ".physics.parabolic",
@@ -93,6 +97,7 @@ _NAMES = {
     "iq_convention": ".imaging.iq",
     "load": ".io",
     "migrate": ".imaging.migrate",
+    "migration_operator": ".imaging.migration.linear",
     "permittivity": ".physics.medium",
     "plan_oblique": ".analysis.oblique_plan",
     "remove_mean": ".data.wideband",
@@ -136,6 +141,8 @@ __all__ = [
     "Image",
     "LineTarget",
     "Medium",
+    "MigrationOperator",
+    "MigrationSettings",
     "ObliquePlan",
     "ParabolicEquation",
     "PlanarTarget",
@@ -158,6 +165,7 @@ __all__ = [
     "iq_convention",
     "load",
     "migrate",
+    "migration_operator",
     "permittivity",
     "plan_oblique",
     "rebar_layers",

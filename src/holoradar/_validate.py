@@ -7,6 +7,8 @@ that a user sees at once which input is wrong and what it should have been.
 from __future__ import annotations
 
 import math
+import os
+import sys
 import warnings
 from collections.abc import Sequence
 
@@ -143,6 +145,21 @@ def as_real(value: object, name: str, *, positive: bool = False,
     return v
 
 
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def outside_stacklevel() -> int:
+    """The ``stacklevel`` that attributes a warning, issued by the function calling this
+    one, to the first caller outside holoradar (the user's line, however deep inside
+    the package the warning arises)."""
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame = frame.f_back
+        level += 1
+    return level
+
+
 def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture", *,
                     round_trip: bool = False) -> None:
     """Warn (and go on) when a sampling pitch exceeds half a wavelength (a quarter for a
@@ -153,7 +170,8 @@ def warn_if_aliased(pitch: float, wavelength: float, what: str = "aperture", *,
         label = "lambda/4 (a transceiver's round trip)" if round_trip else "lambda/2"
         warnings.warn(f"{what} pitch {pitch * 100:.3g} cm exceeds {label} = "
                       f"{wavelength * 100 / div:.3g} cm: waves arriving more than {theta:.1f} "
-                      f"degrees off axis alias", AliasingWarning, stacklevel=3)
+                      f"degrees off axis alias", AliasingWarning,
+                      stacklevel=outside_stacklevel())
 
 
 def as_polarization(value: object, name: str = "polarization") -> np.ndarray | None:

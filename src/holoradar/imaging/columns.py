@@ -37,23 +37,24 @@ import numpy as np
 from .. import _threads
 from .._lazy import lazy_module
 from .._threads import fft_workers, pool
-from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
-from ..physics.propagation import _CACHE, padded_shape
+from ..physics.propagation import _CACHE
+from ..physics.spectra import interpolate
 from . import kspace
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
-__all__ = ["available", "migrate_columns", "output_bytes", "warm"]
+__all__ = ["TINY", "adjoint_columns", "available", "warm"]
 
 _COLS = 256          # components per block of the compiled loop (its terms stay in cache)
 _THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
 _GATHER_BYTES = 1 << 24  # padded spectra of a group of frequencies transformed together
 _BUFFER_SHARE = 0.5  # inverse-FFT buffers at most this share of the output volume,
 _BUFFER_MIN = 1 << 24  # or 16 MiB
-# A term whose weight fell below this fraction of its frequency's largest is dropped:
-# below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128.
-_TINY = {"F": 1e-9, "D": kspace._TINY}
+#: A term whose weight fell below this fraction of its frequency's largest is dropped:
+#: below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128 (by
+#: dtype character; the forward map drops the same terms).
+TINY = {"F": 1e-9, "D": kspace._TINY}
 
 
 def available() -> bool:
@@ -197,58 +198,52 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
                     range(nt)))
 
 
-def output_bytes(hologram: Hologram, nz: int, upsample: int, dtype: Any) -> int:
-    """Bytes of the image volume ``migrate`` returns (all leading axes, ``nz`` planes)."""
-    ny, nx = hologram.data.shape[-2:]
-    u = int(upsample)
-    lead = hologram.data.shape[:-3] if hologram.is_wideband else hologram.data.shape[:-2]
-    return int(np.prod(lead, dtype=np.int64)) * nz * (u * (ny - 1) + 1) * (u * (nx - 1) + 1) \
-        * np.dtype(dtype).itemsize
-
-
-def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: np.ndarray,
-                    *, pad: Any = True, upsample: int = 1, dtype: Any = None) -> Image:
+def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
+                    zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
+                    pad: Any, upsample: int, work: np.dtype, incident: str) -> np.ndarray:
     """The coherent wideband image on uniform planes ``zs`` by the compiled column sum.
 
     Parameters
     ----------
-    hologram : Hologram
-        Wideband (..., nf, ny, nx), a transceiver's or a receiver array's lit by a
-        normal plane wave (or none: phase 0 at the aperture assumed).
+    data : numpy.ndarray
+        ``(B, nf, ny, nx)``: a transceiver's, or a receiver array's lit by a normal
+        plane wave (or none: phase 0 at the aperture assumed).
+    pitch : (dx, dy)
+        Element pitch, metres.
+    ks : numpy.ndarray
+        Wavenumbers in air, rad/m (nf,).
     zs : numpy.ndarray
         Uniformly spaced ranges, metres, all in the medium's deepest region.
     medium : Medium
         The layers (free space included); lossless, or loss left uncompensated.
+    mono : bool
+        A scanned transceiver's round trip.
     weights : numpy.ndarray
         One weight per frequency.
-    pad, upsample, dtype
-        As in :func:`holoradar.migrate`.
+    pad, upsample, work
+        As in :func:`holoradar.migrate` (``work`` the working dtype).
+    incident : {"none", "phase", "field"}
+        A receiver array's normal plane wave factor (:func:`.kspace.frequency_terms`).
 
     Returns
     -------
-    Image
-        (..., nz, ny', nx'), ``method="kspace:coherent"``: the same sum as
-        :func:`holoradar.imaging.kspace.migrate_kspace`, to rounding.
+    numpy.ndarray
+        ``(B, nz, ny', nx')``: the same sum as :func:`.kspace.adjoint_kspace`, to
+        rounding; its exact adjoint is :func:`.kspace.forward_kspace` with
+        ``tiny=TINY[work.char]``.
     """
-    mono = hologram.monostatic
-    dx, dy = hologram.pitch
-    ny, nx = hologram.data.shape[-2:]
-    work = np.dtype(dtype if dtype is not None else (
-        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
+    dx, dy = pitch
+    ny, nx = data.shape[-2:]
     real = np.float32 if work == np.complex64 else np.float64
-    lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
-    grid = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam, z_max=float(zs.max()))
+    grid = kspace.band_grid((ny, nx), pitch, ks, mono, pad, float(zs.max()))
     workers = fft_workers(grid[0] * grid[1])
     weights = np.asarray(weights, dtype=float)
     u = int(upsample)
     direct = u == 1 and grid == (ny, nx)
-    key = ("columns", grid, dx, dy, tuple(float(k) for k in hologram.wavenumbers),
-           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, direct, work.str,
-           tuple(weights != 0))
+    key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
+           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, direct,
+           work.str, tuple(weights != 0))
     plan = _CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
-    data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
-    batch = data.shape[:-3]
-    data = data.reshape((-1, *data.shape[-3:]))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
     run = _kernel()
@@ -283,20 +278,17 @@ def migrate_columns(hologram: Hologram, zs: np.ndarray, medium: Medium, weights:
                 _run(run, plan, ar, ai, j0, j1, zero, buf.view(real).reshape(chunk, -1))
                 nr_j = int(np.count_nonzero(plan.row_reach >= j0))
                 xb = buf[:m, :nr_j]
-                xb = xb if u == 1 else kspace._pad_axis(xb, u, -1)
+                xb = interpolate(xb, u, -1)
                 half = sfft.ifft(xb, axis=-1, workers=workers, overwrite_x=True)
                 cols = np.zeros((m, My, ox), dtype=work)
                 cols[:, plan.rows[:nr_j]] = half[..., :ox]
-                yb = cols if u == 1 else kspace._pad_axis(cols, u, -2)
+                yb = interpolate(cols, u, -2)
                 planes = sfft.ifft(yb, axis=-2, workers=workers, overwrite_x=True)
                 if u > 1:
                     np.multiply(planes[:, :oy], u * u, out=out[b, j0:j1])
                 else:
                     out[b, j0:j1] = planes[:, :oy]
-    out = out.reshape((*batch, zs.size, oy, ox))
-    x = hologram.x[0] + np.arange(ox) * dx / u
-    y = hologram.y[0] + np.arange(oy) * dy / u
-    return Image(out, x, y, zs, hologram.frequencies.copy(), "kspace:coherent")
+    return out
 
 
 @dataclass
@@ -333,11 +325,11 @@ class ColumnPlan:
 
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
-              z0: float, dz: float, nz: int, medium: Medium, mono: bool, direct: bool,
-              work: np.dtype, used: np.ndarray) -> ColumnPlan:
+              z0: float, dz: float, nz: int, medium: Medium, mono: bool, incident: str,
+              direct: bool, work: np.dtype, used: np.ndarray) -> ColumnPlan:
         Mx = grid[1]
         gain_q, step_q, jmax, unfold = kspace.frequency_terms(
-            grid, dx, dy, ks, z0, dz, nz, medium, mono, True, work, used, _TINY[work.char])
+            grid, dx, dy, ks, z0, dz, nz, medium, mono, incident, work, used, TINY[work.char])
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Deepest-reaching first (stable: grid order among equals), so that the blocks

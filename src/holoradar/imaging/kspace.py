@@ -18,8 +18,10 @@ travel leaves the grid, as there).
 Applies when the planes are uniformly spaced and all lie in the deepest region,
 ``fov="aperture"``, ``combine="coherent"``, the illumination is a transceiver's
 own or a plane wave at normal incidence (or none), and no loss compensation is
-needed (lossless layers, or ``compensate_loss=False``). Otherwise
-:func:`holoradar.migrate` sums frequency by frequency.
+needed (lossless layers, or ``compensate_loss=False``) (the ``"kspace"`` backend
+of :mod:`holoradar.imaging.migration` says what blocks it). :func:`forward_kspace`
+is the exact adjoint of the same sum: ``H_f = sum_j conj(w_f gain_f step_f^j) R_j`` over
+the planes each term reaches, ``R_j`` the spectrum of image plane j.
 """
 
 from __future__ import annotations
@@ -31,7 +33,6 @@ import numpy as np
 
 from .._lazy import lazy_module
 from .._threads import fft_workers
-from ..data.hologram import Hologram, Image
 from ..physics.medium import Medium
 from ..physics.propagation import (
     _CACHE,
@@ -40,7 +41,7 @@ from ..physics.propagation import (
     spectral_quadrant,
     two_way_transfer,
 )
-from ..physics.sources import PlaneWave
+from ..physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -49,62 +50,72 @@ _BLOCK = 2048   # spectral components per cache block of the recurrence
 _TINY = 1e-17   # a component below this fraction of its frequency's largest is dropped
 
 
-def applicable(hologram: Hologram, zs: np.ndarray, medium: Medium, *, method: str, fov: str,
-               combine: str, compensate_loss: bool, phase_incident: bool = True) -> bool:
-    """Whether :func:`migrate_kspace` computes exactly what the per-frequency sum does
-    (``phase_incident=False``: what the plane-by-plane migration of each frequency does)."""
-    if method != "angular" or fov != "aperture" or combine != "coherent" or zs.size < 2:
-        return False
-    steps = np.diff(zs)
-    if not np.allclose(steps, steps[0], rtol=1e-9, atol=0) or steps[0] <= 0:
-        return False
-    last = medium.n_regions - 1
-    if np.any(np.asarray(medium.region_of(zs)) != last):
-        return False
-    if compensate_loss and any(complex(e).imag != 0 for e in medium.eps):
-        return False
-    src = hologram.source
-    if hologram.monostatic or src is None or not phase_incident:
-        return True
-    return isinstance(src, PlaneWave) and src.alpha == 0 and src.beta == 0
+def band_grid(shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray, mono: bool,
+              pad: Any, z_max: float) -> tuple[int, int]:
+    """The FFT grid a band shares: sized for its longest wavelength (half of it for a
+    transceiver's round trip) and the deepest plane (:func:`padded_shape`)."""
+    lam = (0.5 if mono else 1.0) * 2 * np.pi / float(np.min(ks))
+    return padded_shape(shape, pad, pitch=pitch, wavelength=lam, z_max=z_max)
 
 
-def migrate_kspace(hologram: Hologram, zs: np.ndarray, medium: Medium, weights: np.ndarray, *,
-                   pad: Any = True, upsample: int = 1, dtype: Any = None,
-                   phase_incident: bool = True) -> Image:
-    """The coherent wideband image on uniform planes ``zs`` (see the module docstring).
+def adjoint_kspace(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
+                   zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
+                   pad: Any, upsample: int, work: np.dtype, incident: str) -> np.ndarray:
+    """The coherent image on uniform planes ``zs`` (see the module docstring).
 
-    ``phase_incident=False`` leaves each frequency's incident phase in (for one
-    frequency: the plain back-propagated field, as :func:`holoradar.migrate`
-    returns it), and the data may lack the frequency axis.
+    ``data``: ``(B, nf, ny, nx)``; returns ``(B, nz, oy, ox)``. ``incident``: the
+    normal plane wave's factor a receiver array's frequencies are multiplied by
+    (``"phase"``: its unit phasor, ``"field"``: the field, ``"none"``).
     """
-    mono = hologram.monostatic
-    dx, dy = hologram.pitch
-    ny, nx = hologram.data.shape[-2:]
-    work = np.dtype(dtype if dtype is not None else (
-        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
-    lam = (0.5 if mono else 1.0) * 2 * np.pi / hologram.wavenumbers.min()
-    fft_shape = padded_shape((ny, nx), pad, pitch=(dx, dy), wavelength=lam,
-                             z_max=float(zs.max()))
-    My, Mx = fft_shape
-    workers = fft_workers(My * Mx)
+    dx, dy = pitch
+    ny, nx = data.shape[-2:]
+    fft_shape = band_grid((ny, nx), pitch, ks, mono, pad, float(zs.max()))
+    workers = fft_workers(fft_shape[0] * fft_shape[1])
     weights = np.asarray(weights, dtype=float)
-    key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in hologram.wavenumbers),
-           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, phase_incident,
+    key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in ks),
+           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident,
            work.str, tuple(weights != 0))
     plan = _CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
-    data = hologram.data if hologram.is_wideband else hologram.data[..., None, :, :]
-    batch = data.shape[:-3]
-    Hc = plan.gather(data.reshape((-1, *data.shape[-3:])), weights, work, workers)
+    Hc = plan.gather(data, weights, work, workers)
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    out = np.empty((*batch, zs.size, oy, ox), dtype=work)
-    plan.sum_planes(Hc, out.reshape((-1, zs.size, oy, ox)), u, workers)
-    x = hologram.x[0] + np.arange(ox) * dx / u
-    y = hologram.y[0] + np.arange(oy) * dy / u
-    if not hologram.is_wideband:
-        return Image(out, x, y, zs, hologram.frequency, "angular")
-    return Image(out, x, y, zs, hologram.frequencies.copy(), "kspace:coherent")
+    out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
+    plan.sum_planes(Hc, out, u, workers)
+    return out
+
+
+def forward_kspace(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float, float],
+                   ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
+                   weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
+                   incident: str, tiny: float = _TINY) -> np.ndarray:
+    """The exact adjoint of :func:`adjoint_kspace` (and of the compiled sum with its
+    ``tiny``): image ``(B, nz, oy, ox)`` -> samples ``(B, nf, ny, nx)``.
+
+    Each image plane's spectrum (the adjoint of the cropped, interpolated inverse
+    FFT) meets every frequency's terms: ``H_f += conj(w_f gain_f step_f^j) R_j`` while
+    plane ``j`` is within the term's reach; one inverse FFT per frequency.
+    """
+    dx, dy = pitch
+    ny, nx = shape
+    grid = band_grid(shape, pitch, ks, mono, pad, float(zs.max()))
+    My, Mx = grid
+    workers = fft_workers(My * Mx)
+    w = np.asarray(weights, dtype=float)
+    gain, step, jmax, unfold = frequency_terms(
+        grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), float(zs[1] - zs[0]),
+        zs.size, medium, mono, incident, work, w != 0, tiny)
+    # Conjugated, weighted and on the whole grid: the forward terms.
+    cur = np.conj(gain[:, unfold]) * w[:, None].astype(work)
+    back = np.conj(step[:, unfold])
+    u = int(upsample)
+    B = image.shape[0]
+    H = np.zeros((B, len(ks), My * Mx), dtype=work)
+    for j in range(zs.size):
+        R = fold(fft2_padded(image[:, j], (u * My, u * Mx), work, workers), u)
+        live = jmax >= j
+        H += np.where(live, cur, 0)[None] * R.reshape(B, 1, -1)
+        cur *= back
+    return ifft2_cropped(H.reshape(B, len(ks), My, Mx), (ny, nx), workers, overwrite=True)
 
 
 @dataclass
@@ -142,10 +153,10 @@ class _Plan:
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
               z0: float, dz: float, nz: int, medium: Medium, mono: bool,
-              phase_incident: bool, work: np.dtype, used: np.ndarray) -> _Plan:
+              incident: str, work: np.dtype, used: np.ndarray) -> _Plan:
         Mx = grid[1]
         gain, step, jmax, unfold = frequency_terms(grid, dx, dy, ks, z0, dz, nz, medium, mono,
-                                                   phase_incident, work, used)
+                                                   incident, work, used)
         nf = len(ks)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
@@ -244,10 +255,11 @@ class _Plan:
 
 def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
                     z0: float, dz: float, nz: int, medium: Medium, mono: bool,
-                    phase_incident: bool, work: np.dtype, used: np.ndarray,
+                    incident: str, work: np.dtype, used: np.ndarray,
                     tiny: float = _TINY) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per frequency, on one quadrant of the spectrum: the conjugate transfer to the
-    first plane (with the incident phase for a receiver array when ``phase_incident``),
+    first plane (a receiver array's: times the conjugate of a normal plane wave's
+    incident factor, ``incident`` "phase" ``E0/|E0|`` or "field" ``E0``, or "none"),
     the plane-to-plane step ``exp(-i conj(Kz) dz)``, and the last plane each component
     of the full grid takes part in (-1: none; a frequency with ``used[i]`` False
     takes part nowhere). ``tiny``: a term whose weight has fallen below this fraction of
@@ -277,13 +289,15 @@ def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float
             Kz = medium.kz(k, kappa2, last)
             t0 = lateral_travel(k, medium, kappa2, z0)
             evanescent = kappa2 > k * k
-            if phase_incident:
+            if incident != "none":
                 e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, z0))
-                a = a * (np.conj(e0) / abs(e0))
+                a = a * (np.conj(e0) / abs(e0) if incident == "phase" else np.conj(e0))
         rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
         s = np.exp(-1j * np.conj(Kz) * dz)
-        if not mono and phase_incident:
+        if not mono and incident == "phase":
             s = s * np.exp(-1j * (k * n_last).real * dz)
+        elif not mono and incident == "field":   # E0 grows by exp(i k n dz) a plane
+            s = s * np.exp(-1j * np.conj(k * n_last) * dz)
         gain[i], step[i] = a.ravel(), s.ravel()
         # The band limit at the first plane (jmax < 0) is the per-plane one.
         jmax[i] = _last_planes(a, s, evanescent, p, q, t0, rate, dz, grid, (dx, dy),
@@ -340,27 +354,10 @@ def _inverse_cropped(spec: np.ndarray, flat: np.ndarray, scatter: tuple, grid: t
     buf = np.zeros((*lead, used.size * Mx), dtype=spec.dtype)
     for i in np.ndindex(lead):   # one index at a time: much faster than broadcast
         buf[i][pos] = spec[i]
-    buf = _pad_axis(buf.reshape((*lead, used.size, Mx)), u, -1)
+    buf = interpolate(buf.reshape((*lead, used.size, Mx)), u, -1)
     half = sfft.ifft(buf, axis=-1, workers=workers, overwrite_x=True)[..., :ox]
     cols = np.zeros((*lead, My, ox), dtype=spec.dtype)
     cols[..., used, :] = half
-    planes = sfft.ifft(_pad_axis(cols, u, -2), axis=-2, workers=workers,
+    planes = sfft.ifft(interpolate(cols, u, -2), axis=-2, workers=workers,
                        overwrite_x=True)[..., :oy, :]
     return planes * (u * u) if u > 1 else planes
-
-
-def _pad_axis(S: np.ndarray, u: int, axis: int) -> np.ndarray:
-    """Embed an FFT-ordered spectrum along one axis in a ``u`` times longer one
-    (exact band-limited interpolation; an even size's Nyquist bin split in half
-    between + and -, so that a real signal stays real)."""
-    if u == 1:
-        return S
-    S = np.moveaxis(S, axis, -1)
-    M = S.shape[-1]
-    out = np.zeros((*S.shape[:-1], u * M), dtype=S.dtype)
-    h = (M + 1) // 2
-    out[..., :h] = S[..., :h]
-    out[..., u * M - M // 2:] = S[..., M - M // 2:]
-    if M % 2 == 0:
-        out[..., M // 2] = out[..., u * M - M // 2] = 0.5 * out[..., u * M - M // 2]
-    return np.moveaxis(out, -1, axis)

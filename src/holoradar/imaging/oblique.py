@@ -37,6 +37,7 @@ cannot reach the ground.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -44,7 +45,7 @@ import numpy as np
 from .._lazy import lazy_module
 from .._threads import fft_workers
 from .._validate import as_axis, uniform_step
-from ..data.hologram import Hologram, Image
+from ..data.hologram import Hologram
 from ..physics.medium import Medium
 from ..physics.propagation import (
     _CACHE,
@@ -54,8 +55,8 @@ from ..physics.propagation import (
     padded_shape,
     spectral_axes,
 )
-from .kspace import _pad_axis
-from .oblique_nufft import spectrum_nufft
+from ..physics.spectra import fft2_padded, fold, interpolate
+from .oblique_nufft import elements_nufft, spectrum_nufft
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -97,24 +98,49 @@ def ground_grid(hologram: Hologram, zs: np.ndarray, medium: Medium,
     return lo[0] + step * np.arange(max(nx, 2)), lo[1] + step * np.arange(max(ny, 2))
 
 
-def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
-                   x: Any = None, y: Any = None, pad: Any = True, upsample: int = 1,
-                   compensate_loss: float | None = None, dtype: Any = None,
-                   route: str = "auto") -> Image:
-    """Single-frequency image of a posed hologram on horizontal world planes ``zs``.
+@dataclass(frozen=True)
+class GroundGrid:
+    """The periodic world grid of one frequency's ground-frame migration (see
+    :func:`ground_setup`)."""
 
-    ``compensate_loss``: the SNR in dB that limits the loss compensation, or None
-    for the plain adjoint. ``route``: how the data's spectrum on the reference plane
-    is summed: ``"direct"`` (the factored sums, exact to rounding), ``"nufft"``
-    (finufft, relative error ``oblique_nufft.EPS``: 1e-6 in complex128, 1e-5 in
-    complex64) or ``"auto"`` (the faster as measured, :func:`choose_route`).
-    Returns an Image in the world frame, data (..., nz, ny, nx).
+    x: np.ndarray            # output pixels, world metres
+    y: np.ndarray
+    grid: tuple[int, int]    # (My, Mx) FFT grid
+    pitch: tuple[float, float]   # its pitch (dcx, dcy)
+    up: tuple[int, int]      # (uy, ux): interpolation of the spectrum onto the output
+    down: tuple[int, int]    # (my, mx): every m-th interpolated sample is an output pixel
+    z_ref: float             # the reference plane (the lowest element's world range)
+    rise: float              # height span of the elements
+    reach: tuple[float, float]   # farthest element-pixel distance along x, y
+    gap: float               # shortest air path below the reference plane
+    medium: Medium           # the layers seen from the reference plane
+    k: float
+    mono: bool
+    workers: int
+
+    @property
+    def crop(self) -> tuple[int, int]:
+        my, mx = self.down
+        return my * (self.y.size - 1) + 1, mx * (self.x.size - 1) + 1
+
+    def transfer(self, z: float, work: np.dtype, snr: float | None) -> np.ndarray:
+        """The adjoint transfer from world range ``z`` to the reference plane, band
+        limited (cached)."""
+        return _ground_transfer(self.grid, self.pitch, self.k, self.medium, float(z - self.z_ref),
+                                self.rise, self.mono, self.reach, work, snr)
+
+
+def ground_setup(geometry: Hologram, k: float, zs: np.ndarray, medium: Medium, *,
+                 x: Any = None, y: Any = None, pad: Any = True,
+                 upsample: int = 1) -> GroundGrid:
+    """Check a ground-frame migration's planes and size its world FFT grid.
+
+    ``geometry``: the posed hologram (its elements' world positions, pose, grid);
+    ``k`` the wavenumber in air of the frequency (rad/m). ``ValueError`` when the
+    aperture's elements reach the ground or a plane lies above the lowest element.
     """
-    if route not in ("auto", "nufft", "direct"):
-        raise ValueError(f"route must be 'auto', 'nufft' or 'direct', got {route!r}")
-    k = hologram.k
-    mono = hologram.monostatic
-    pts = hologram.points
+    mono = geometry.monostatic
+    pts = geometry.points
     z_ref = float(pts[:, 2].max())
     if not medium.is_free_space and z_ref >= medium.z_interfaces[0]:
         raise ValueError(f"hologram.pose puts elements at or below the ground surface (z = "
@@ -123,14 +149,12 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
         raise ValueError(f"z must lie below the aperture's lowest element (world range "
                          f"{z_ref:.4g} m) in frame='ground', got min(z) = {zs.min():.4g} m")
     if x is None or y is None:
-        gx, gy = ground_grid(hologram, zs, medium, upsample)
+        gx, gy = ground_grid(geometry, zs, medium, upsample)
         x = gx if x is None else x
         y = gy if y is None else y
     xo = as_axis(x, "x")
     yo = as_axis(y, "y")
     dxw, dyw = uniform_step(xo, "x"), uniform_step(yo, "y")
-    work = np.dtype(dtype if dtype is not None else (
-        np.complex64 if hologram.data.dtype == np.complex64 else np.complex128))
     kk = 2 * k if mono else k
     # The shortest air path below the reference plane to anything imaged: components
     # evanescent in the air that it damps below 1e-8 cannot matter; the rest of the
@@ -166,20 +190,56 @@ def migrate_ground(hologram: Hologram, zs: np.ndarray, medium: Medium, *,
         # (the kernel then matches the exact layered Green's function to ~1%, tested).
         grid = tuple(max(m, sfft.next_fast_len(int(np.ceil(4 * r / d)), real=False))
                      for m, r, d in zip(grid, reach[::-1], (dcy, dcx), strict=True))
-    shifted = _shifted(medium, z_ref)
-    H = _spectrum_on_plane(hologram, grid, (dcx, dcy), (xo[0], yo[0], z_ref), work, gap,
-                           route)
-    out = np.empty((*H.shape[:-2], zs.size, yo.size, xo.size), dtype=work)
-    workers = fft_workers(grid[0] * grid[1] * ux * uy)
+    xo.setflags(write=False)
+    yo.setflags(write=False)
+    return GroundGrid(xo, yo, grid, (dcx, dcy), (uy, ux), (my, mx), z_ref, rise, reach, gap,
+                      _shifted(medium, z_ref), float(k), mono,
+                      fft_workers(grid[0] * grid[1] * ux * uy))
+
+
+def adjoint_ground(geometry: Hologram, data: np.ndarray, g: GroundGrid, zs: np.ndarray, *,
+                   snr: float | None, work: np.dtype, route: str) -> np.ndarray:
+    """One frequency's image of posed data ``(B, ny, nx)`` on horizontal world planes
+    ``zs``: ``(B, nz, ny', nx')`` on ``g``'s output grid.
+
+    ``snr``: the SNR in dB that limits the loss compensation, or None for the plain
+    adjoint. ``route``: how the data's spectrum on the reference plane is summed:
+    ``"direct"`` (the factored sums, exact to rounding) or ``"nufft"`` (finufft,
+    relative error ``oblique_nufft.EPS``: 1e-6 in complex128, 1e-5 in complex64).
+    """
+    H = spectrum_on_plane(geometry, data, g, work, route)
+    out = np.empty((data.shape[0], zs.size, g.y.size, g.x.size), dtype=work)
+    my, mx = g.down
     for j, z in enumerate(zs):
-        Uc = _ground_transfer(grid, (dcx, dcy), k, shifted, float(z - z_ref), rise, mono,
-                              reach, work, compensate_loss)
-        full = _inverse_upsampled(H * Uc, (uy, ux), (my * (yo.size - 1) + 1,
-                                                      mx * (xo.size - 1) + 1), workers)
+        full = _inverse_upsampled(H * g.transfer(z, work, snr), g.up, g.crop, g.workers)
         # ifft2 gives the kernel times the grid's cell area: scaled to the output's.
-        out[..., j, :, :] = full[..., ::my, ::mx] * (mx * my) if mx * my > 1 \
-            else full
-    return Image(out, xo.copy(), yo.copy(), zs, hologram.frequency, "angular:ground")
+        out[:, j] = full[..., ::my, ::mx] * (mx * my) if mx * my > 1 else full
+    return out
+
+
+def forward_ground(geometry: Hologram, image: np.ndarray, g: GroundGrid, zs: np.ndarray, *,
+                   snr: float | None, work: np.dtype, route: str) -> np.ndarray:
+    """The exact adjoint of :func:`adjoint_ground`: world planes ``(B, nz, ny', nx')`` ->
+    samples at the posed elements ``(B, ny, nx)``.
+
+    Each plane is placed on the interpolated grid (every m-th sample), transformed and
+    folded (the adjoint of the interpolated, cropped inverse FFT), carried up to the
+    reference plane by the conjugate of the adjoint transfer, and the sum over planes
+    is evaluated at the elements by the adjoint of the spectrum's sum
+    (:func:`spectrum_at_elements`).
+    """
+    My, Mx = g.grid
+    uy, ux = g.up
+    my, mx = g.down
+    cy, cx = g.crop
+    acc = np.zeros((image.shape[0], My, Mx), dtype=work)
+    for j, z in enumerate(zs):
+        placed = np.zeros((image.shape[0], cy, cx), dtype=work)
+        placed[:, ::my, ::mx] = image[:, j] * (mx * my) if mx * my > 1 else image[:, j]
+        R = fold(fold(fft2_padded(placed, (uy * My, ux * Mx), work, g.workers), uy, -2),
+                 ux, -1)
+        acc += R * np.conj(g.transfer(z, work, snr))
+    return spectrum_at_elements(geometry, acc / (My * Mx), g, work, route)
 
 
 def _inverse_upsampled(S: np.ndarray, u: tuple[int, int], crop: tuple[int, int],
@@ -188,9 +248,9 @@ def _inverse_upsampled(S: np.ndarray, u: tuple[int, int], crop: tuple[int, int],
     the spectrum), cropped to ``crop``: along x, crop, then along y."""
     uy, ux = u
     oy, ox = crop
-    half = sfft.ifft(_pad_axis(S, ux, -1), axis=-1, workers=workers,
+    half = sfft.ifft(interpolate(S, ux, -1), axis=-1, workers=workers,
                      overwrite_x=True)[..., :ox]
-    out = sfft.ifft(_pad_axis(half, uy, -2), axis=-2, workers=workers,
+    out = sfft.ifft(interpolate(half, uy, -2), axis=-2, workers=workers,
                     overwrite_x=True)[..., :oy, :]
     return out * (ux * uy) if ux * uy > 1 else out
 
@@ -274,53 +334,127 @@ def _shifted(medium: Medium, z_ref: float) -> Medium:
                   medium.polarization)
 
 
-def _spectrum_on_plane(hologram: Hologram, grid: tuple[int, int], pitch: tuple[float, float],
-                       origin: tuple[float, float, float], work: np.dtype,
-                       gap: float, route: str = "auto") -> np.ndarray:
-    """``H(k)`` on the (My, Mx) world grid: the adjoint of the plane-wave field at the
-    elements (module docstring), for every leading frame of ``hologram.data``.
+def spectrum_on_plane(geometry: Hologram, data: np.ndarray, g: GroundGrid, work: np.dtype,
+                      route: str = "auto") -> np.ndarray:
+    """``H(k)`` on ``g``'s world grid: the adjoint of the plane-wave field at the
+    elements (module docstring), for every frame of ``data`` ``(B, ny, nx)`` ->
+    ``(B, My, Mx)`` (:func:`sum_to_plane` on ``g``'s grid)."""
+    kk, origin = _sum_terms(g)
+    return sum_to_plane(geometry, data, kk, g.grid, g.pitch, origin, work, g.gap, route)
 
-    ``route``: ``"direct"`` (the factored sums below, exact to rounding), ``"nufft"``
-    (:func:`.oblique_nufft.spectrum_nufft`, finufft to its ``EPS``) or ``"auto"``
-    (:func:`choose_route`).
+
+def spectrum_at_elements(geometry: Hologram, G: np.ndarray, g: GroundGrid, work: np.dtype,
+                         route: str = "auto") -> np.ndarray:
+    """The exact adjoint of :func:`spectrum_on_plane` (:func:`sum_to_elements`)."""
+    kk, origin = _sum_terms(g)
+    return sum_to_elements(geometry, G, kk, g.grid, g.pitch, origin, work, g.gap, route)
+
+
+def sum_to_plane(geometry: Hologram, data: np.ndarray, kk: float, grid: tuple[int, int],
+                 pitch: tuple[float, float], origin: tuple[float, float, float],
+                 work: np.dtype, gap: float, route: str = "auto") -> np.ndarray:
+    """``H(k) = sum_e d_e exp(-i K.(r_e - r0))`` at every wavenumber of a world grid.
+
+    Parameters
+    ----------
+    geometry : Hologram
+        The posed aperture (pose, element axes).
+    data : numpy.ndarray
+        ``(B, ny, nx)`` samples.
+    kk : float
+        The sum's wavenumber, rad/m (``2 k`` for a transceiver's round trip).
+    grid, pitch, origin
+        The world FFT grid ``(My, Mx)``, its pitch ``(dx, dy)`` and its origin
+        ``(x0, y0, z_ref)``, metres.
+    work : numpy.dtype
+    gap : float
+        The shortest air path below the reference plane to anything imaged, metres:
+        components evanescent in the air that it damps below 1e-8 are left out.
+    route : {"auto", "direct", "nufft"}
+        ``"direct"`` (the factored sums below, exact to rounding), ``"nufft"``
+        (:func:`.oblique_nufft.spectrum_nufft`, finufft to its ``EPS``) or ``"auto"``
+        (:func:`choose_route`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(B, My, Mx)``.
     """
-    My, Mx = grid
-    k = hologram.k
-    kk = 2 * k if hologram.monostatic else k
-    pose = hologram.pose
+    route = _route(geometry, grid, route)
     reach = -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12)   # largest Im(kz) kept
-    if route == "auto":
-        # finufft needs the elements on a uniform grid; the direct sums do not
-        route = choose_route(grid, pose, hologram.data.shape[-2:]) \
-            if _uniform(hologram.x) and _uniform(hologram.y) else "direct"
     if route == "nufft":
-        return spectrum_nufft(hologram, grid, pitch, origin, work, reach)
-    key = ("ground-basis", grid, pitch, origin, kk, pose, hologram.x.tobytes(),
-           hologram.y.tobytes(), work.str, round(reach, 6))
-    basis = _CACHE.get(key, lambda: _Remap.build(grid, pitch, origin, kk, pose, hologram.x,
-                                                 hologram.y, work, reach))
-    d = hologram.data.astype(work, copy=False)
-    lead = d.shape[:-2]
-    d = d.reshape((-1, *d.shape[-2:]))                          # (B, ny, nx)
+        return spectrum_nufft(geometry, data, kk, grid, pitch, origin, work, reach)
+    basis = _remap(geometry, kk, grid, pitch, origin, work, reach)
+    My, Mx = grid
+    d = data.astype(work, copy=False)
     if basis.mode == "columns":
         # x' horizontal along x: its phase depends on the grid column only. One small
         # product per column, then per column a (My x ny) matrix-vector product.
         t = np.matmul(d, basis.ea.T)                             # (B, ny, Mx)
         t = np.moveaxis(t, 2, 1)[..., None]                      # (B, Mx, ny, 1)
         Hd = np.matmul(basis.eb, t)[..., 0]                      # (B, Mx, My)
-        return (np.swapaxes(Hd, 1, 2) * basis.phase).reshape((*lead, My, Mx))
+        return np.swapaxes(Hd, 1, 2) * basis.phase
     if basis.mode == "rows":
         # y' horizontal along y: the same with the roles of the axes exchanged.
         t = np.matmul(basis.eb, d)[..., None]                    # (B, My, nx, 1)
         Hd = np.matmul(basis.ea, t)[..., 0]                      # (B, My, Mx)
-        return (Hd * basis.phase).reshape((*lead, My, Mx))
+        return Hd * basis.phase
     # sum_j d[b, i, j] Ea[m, j] -> (B, n, ny), then sum_i Eb[m, i] * that.
     t = np.einsum("bij,mj->bmi", d, basis.ea, optimize=True)
     vals = np.einsum("bmi,mi->bm", t, basis.eb, optimize=True)
     vals = vals * basis.phase
     H = np.zeros((d.shape[0], My * Mx), dtype=work)
     H[:, basis.index] = vals
-    return H.reshape((*lead, My, Mx))
+    return H.reshape(d.shape[0], My, Mx)
+
+
+def sum_to_elements(geometry: Hologram, G: np.ndarray, kk: float, grid: tuple[int, int],
+                    pitch: tuple[float, float], origin: tuple[float, float, float],
+                    work: np.dtype, gap: float, route: str = "auto") -> np.ndarray:
+    """The exact adjoint of :func:`sum_to_plane`: a spectrum ``(B, My, Mx)`` evaluated at
+    the posed elements, ``sum_k G(k) conj(exp(-i K.(r_e - r0)))`` -> ``(B, ny, nx)``
+    (divided by ``My Mx``: the field of those plane waves there, the module
+    docstring's ``u(r_e)``); the nufft route to finufft's ``EPS``."""
+    route = _route(geometry, grid, route)
+    reach = -np.log(_EVANESCENT_FLOOR) / max(gap, 1e-12)
+    if route == "nufft":
+        return elements_nufft(geometry, G, kk, grid, pitch, origin, work, reach)
+    basis = _remap(geometry, kk, grid, pitch, origin, work, reach)
+    B = G.shape[0]
+    if basis.mode == "columns":
+        Hd = np.swapaxes(G * np.conj(basis.phase), 1, 2)         # (B, Mx, My)
+        t = np.matmul(np.conj(np.swapaxes(basis.eb, 1, 2)), Hd[..., None])[..., 0]
+        return np.einsum("bxi,xj->bij", t, np.conj(basis.ea), optimize=True)
+    if basis.mode == "rows":
+        gp = G * np.conj(basis.phase)                            # (B, My, Mx)
+        t = np.einsum("yxj,byx->byj", np.conj(basis.ea), gp, optimize=True)
+        return np.einsum("yi,byj->bij", np.conj(basis.eb), t, optimize=True)
+    vals = G.reshape(B, -1)[:, basis.index] * np.conj(basis.phase)
+    t = vals[:, :, None] * np.conj(basis.eb)[None]              # (B, n, ny)
+    return np.einsum("bmi,mj->bij", t, np.conj(basis.ea), optimize=True)
+
+
+def _route(geometry: Hologram, grid: tuple[int, int], route: str) -> str:
+    if route not in ("auto", "nufft", "direct"):
+        raise ValueError(f"route must be 'auto', 'nufft' or 'direct', got {route!r}")
+    if route == "auto":
+        # finufft needs the elements on a uniform grid; the direct sums do not
+        return choose_route(grid, geometry.pose, geometry.data.shape[-2:]) \
+            if _uniform(geometry.x) and _uniform(geometry.y) else "direct"
+    return route
+
+
+def _sum_terms(g: GroundGrid) -> tuple[float, tuple[float, float, float]]:
+    """The sum's wavenumber and the grid's origin."""
+    return 2 * g.k if g.mono else g.k, (float(g.x[0]), float(g.y[0]), g.z_ref)
+
+
+def _remap(geometry: Hologram, kk: float, grid: tuple[int, int], pitch: tuple[float, float],
+           origin: tuple[float, float, float], work: np.dtype, reach: float) -> _Remap:
+    key = ("ground-basis", grid, pitch, origin, kk, geometry.pose, geometry.x.tobytes(),
+           geometry.y.tobytes(), work.str, round(reach, 6))
+    return _CACHE.get(key, lambda: _Remap.build(grid, pitch, origin, kk, geometry.pose,
+                                                geometry.x, geometry.y, work, reach))
 
 
 #: The direct route's multiply-adds up to which it stays the default (its cost grows

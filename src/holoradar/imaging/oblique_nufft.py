@@ -47,15 +47,19 @@ EPS = {np.dtype(np.complex128): 1e-6, np.dtype(np.complex64): 1e-5}
 _ONE_THREAD_BELOW = 2**17
 
 
-def spectrum_nufft(hologram: Hologram, grid: tuple[int, int], pitch: tuple[float, float],
-                   origin: tuple[float, float, float], work: np.dtype,
-                   reach: float) -> np.ndarray:
-    """``H(k)`` on the ``(My, Mx)`` world grid for every leading frame of the data.
+def spectrum_nufft(geometry: Hologram, data: np.ndarray, kk: float, grid: tuple[int, int],
+                   pitch: tuple[float, float], origin: tuple[float, float, float],
+                   work: np.dtype, reach: float) -> np.ndarray:
+    """``H(k)`` on the ``(My, Mx)`` world grid for every frame of ``data``.
 
     Parameters
     ----------
-    hologram : Hologram
-        Posed data, shape ``(..., ny, nx)`` on a uniform aperture grid.
+    geometry : Hologram
+        The posed aperture (its pose and uniform element grid).
+    data : numpy.ndarray
+        ``(B, ny, nx)``, the samples.
+    kk : float
+        The sum's wavenumber, rad/m (``2 k`` for a transceiver's round trip).
     grid : (My, Mx)
         The world FFT grid.
     pitch : (dx, dy)
@@ -71,23 +75,42 @@ def spectrum_nufft(hologram: Hologram, grid: tuple[int, int], pitch: tuple[float
     Returns
     -------
     numpy.ndarray
-        Shape ``(..., My, Mx)``, dtype ``work``.
+        Shape ``(B, My, Mx)``, dtype ``work``.
     """
     My, Mx = grid
-    kk = 2 * hologram.k if hologram.monostatic else hologram.k
-    key = ("ground-nufft", grid, pitch, origin, kk, hologram.pose, hologram.x.tobytes(),
-           hologram.y.tobytes(), work.str, round(reach, 6))
-    basis = _CACHE.get(key, lambda: _NufftRemap.build(grid, pitch, origin, kk, hologram.pose,
-                                                      hologram.x, hologram.y, work, reach))
-    d = hologram.data.astype(work, copy=False)
-    lead = d.shape[:-2]
-    d = np.ascontiguousarray(d.reshape((-1, *d.shape[-2:])))     # (B, ny, nx)
+    basis = _basis_of(geometry, kk, grid, pitch, origin, work, reach)
+    d = np.ascontiguousarray(data.astype(work, copy=False))       # (B, ny, nx)
     H = np.zeros((d.shape[0], My * Mx), dtype=work)
     if basis.prop.size:
         H[:, basis.prop] = basis.execute(d) * basis.phase
     if basis.ev.size:
         H[:, basis.ev] = basis.evanescent(d)
-    return H.reshape((*lead, My, Mx))
+    return H.reshape(d.shape[0], My, Mx)
+
+
+def elements_nufft(geometry: Hologram, G: np.ndarray, kk: float, grid: tuple[int, int],
+                   pitch: tuple[float, float], origin: tuple[float, float, float],
+                   work: np.dtype, reach: float) -> np.ndarray:
+    """The adjoint of :func:`spectrum_nufft`: a spectrum ``(B, My, Mx)`` on the world grid
+    to ``(B, ny, nx)`` at the elements (a type-1 NUFFT, ``isign = +1``, at the same
+    points, and the evanescent sums' transposes), to finufft's ``EPS``."""
+    basis = _basis_of(geometry, kk, grid, pitch, origin, work, reach)
+    Gf = G.reshape(G.shape[0], -1)
+    out = np.zeros((G.shape[0], *basis.shape), dtype=work)
+    if basis.prop.size:
+        out += basis.execute_adjoint(np.ascontiguousarray(
+            Gf[:, basis.prop] * np.conj(basis.phase)))
+    if basis.ev.size:
+        out += basis.evanescent_adjoint(Gf[:, basis.ev])
+    return out
+
+
+def _basis_of(geometry: Hologram, kk: float, grid: tuple[int, int], pitch: tuple[float, float],
+              origin: tuple[float, float, float], work: np.dtype, reach: float) -> _NufftRemap:
+    key = ("ground-nufft", grid, pitch, origin, kk, geometry.pose, geometry.x.tobytes(),
+           geometry.y.tobytes(), work.str, round(reach, 6))
+    return _CACHE.get(key, lambda: _NufftRemap.build(grid, pitch, origin, kk, geometry.pose,
+                                                     geometry.x, geometry.y, work, reach))
 
 
 class _NufftRemap:
@@ -154,6 +177,49 @@ class _NufftRemap:
             out[:, sl] = np.einsum("bic,ci->bc", t, eb) * self.ev_phase[sl]
         return out
 
+    def execute_adjoint(self, c: np.ndarray) -> np.ndarray:
+        """The type-1 sums from the travelling components' values ``(B, n_prop)`` onto
+        the element modes, ``(B, ny, nx)``: the adjoint of :meth:`execute`."""
+        n = c.shape[0]
+        with self._lock:
+            plan = self._plans.get(-n)
+            if plan is None:
+                threads = 1 if self.prop.size < _ONE_THREAD_BELOW else 0
+                plan = finufft.Plan(1, self.shape, n_trans=n, eps=EPS[self.work], isign=1,
+                                    dtype=self.work.name, nthreads=threads)
+                plan.setpts(*self.pts)
+                self._plans[-n] = plan
+            out = plan.execute(c.astype(self.work, copy=False) if n > 1 else
+                               c[0].astype(self.work, copy=False))
+        return out.reshape(n, *self.shape)
+
+    def evanescent_adjoint(self, g: np.ndarray) -> np.ndarray:
+        """The adjoint of :meth:`evanescent`: values at the kept air-evanescent
+        components ``(B, n_ev)`` to ``(B, ny, nx)``."""
+        g = g * np.conj(self.ev_phase)
+        ny, nx = self.shape
+        B = g.shape[0]
+        if self.ev_mode == "columns":
+            t = _horner_adjoint(g, self.ev_line, np.conj(self.ev_z), ny,
+                                self.fixed.shape[0])                       # (B, ny, Mx)
+            d = np.matmul(t, np.conj(self.fixed))                          # (B, ny, nx)
+        elif self.ev_mode == "rows":
+            t = _horner_adjoint(g, self.ev_line, np.conj(self.ev_w), nx,
+                                self.fixed.shape[0])                       # (B, nx, My)
+            d = np.matmul(np.conj(self.fixed).T, np.swapaxes(t, 1, 2))    # (B, ny, nx)
+        else:
+            d = np.zeros((B, ny, nx), dtype=self.work)
+            for lo in range(0, self.ev.size, _CHUNK):
+                sl = slice(lo, lo + _CHUNK)
+                ea = np.conj(_powers(self.ev_w[sl], nx))                   # (c, nx)
+                eb = np.conj(_powers(self.ev_z[sl], ny))                   # (c, ny)
+                d += np.einsum("bc,ci,cj->bij", g[:, sl], eb, ea, optimize=True)
+        if self.flip[1]:
+            d = d[..., ::-1, :]
+        if self.flip[0]:
+            d = d[..., ::-1]
+        return d
+
     @classmethod
     def build(cls, grid: tuple[int, int], pitch: tuple[float, float],
               origin: tuple[float, float, float], kk: float, pose: Any, xl: np.ndarray,
@@ -219,6 +285,20 @@ def _horner(t: np.ndarray, line: np.ndarray, z: np.ndarray) -> np.ndarray:
         acc *= z
         acc += t[:, k, line]
     return acc
+
+
+def _horner_adjoint(g: np.ndarray, line: np.ndarray, zc: np.ndarray, n: int,
+                    width: int) -> np.ndarray:
+    """The adjoint of :func:`_horner`: ``t[:, k, line_m] += zc_m**k g[:, m]`` for
+    ``k < n``, ``zc`` the conjugate ratios; ``(B, n, width)``."""
+    t = np.zeros((g.shape[0], n, width), dtype=np.result_type(g, zc))
+    cur = g.copy()
+    for k in range(n):
+        for b in range(g.shape[0]):
+            t[b, k] = np.bincount(line, cur[b].real, width) + 1j * np.bincount(
+                line, cur[b].imag, width)
+        cur *= zc
+    return t
 
 
 def _powers(z: np.ndarray, n: int) -> np.ndarray:

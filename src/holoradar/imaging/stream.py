@@ -21,19 +21,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .._lazy import lazy_module
-from .._threads import fft_workers
 from ..data.hologram import Hologram, Image
-from ..physics.incident import incident_on_plane
 from ..physics.medium import Medium
-from ..physics.propagation import AngularSpectrum
+from ..physics.propagation import DEFAULT_SNR_DB
 from ..physics.sources import PointSource
 from ..theory import lateral_resolution
 from .glare import FitWarning, _direct_wave, suppress_surface
-from .migrate import _zero_pad_spectrum
+from .migration.image import Migration
+from .migration.settings import MigrationSettings
 from .synthesis import _check_views
-
-sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["StreamImager"]
 
@@ -80,8 +76,6 @@ class StreamImager:
         if np.ndim(z) != 0:
             raise ValueError(f"z must be one range in metres (a frame images one plane), got "
                              f"{z!r}")
-        if not isinstance(upsample, int | np.integer) or upsample < 1:
-            raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
         for i, v in enumerate(views):
             if not v.pose.is_identity:
                 raise ValueError(f"views[{i}].pose must be the identity (a frontal array at "
@@ -91,29 +85,19 @@ class StreamImager:
         self.k = h0.k
         self.shape = h0.data.shape[-2:]
         self.suppress = suppress
-        dx, dy = h0.pitch
-        self.op = AngularSpectrum(self.shape, dx, dy, h0.k, float(z), medium, pad=True,
-                                  compensate_loss=True)  # as migrate() does
-        self.uc = self.op.adjoint_transfers[0]
-        self.u = int(upsample)
-        My, Mx = self.op.fft_shape
-        oy, ox = self.u * My, self.u * Mx
-        self.roll = (self.u * ((My - self.shape[0]) // 2), self.u * ((Mx - self.shape[1]) // 2))
-        self.x = h0.x[0] + (np.arange(ox) - self.roll[1]) * dx / self.u
-        self.y = h0.y[0] + (np.arange(oy) - self.roll[0]) * dy / self.u
+        dx = h0.pitch[0]
+        # Each view's migration frozen for the imager's life: the whole padded grid,
+        # the loss compensated (one SNR for every view and frame, so that they add
+        # alike), the view's incident phase removed at every pixel (the operator's
+        # "phase" illumination, computed once).
+        settings = MigrationSettings(upsample=upsample, fov="full", illumination="phase",
+                                     snr_db=DEFAULT_SNR_DB, progress=False)
+        self.migrations = [Migration(v, float(z), medium, settings) for v in views]
+        m0 = self.migrations[0]
+        self.x, self.y = m0.x, m0.y
         self.z = float(z)
         self.frequency = h0.frequency
         med = medium if medium is not None else Medium.free_space()
-        # Phasors in the FFT's own (unrolled) pixel order: the sum is rolled once.
-        ph = []
-        for v in views:
-            e0 = incident_on_plane(v.source, self.k, med, self.x, self.y, self.z)
-            mag = np.abs(e0)
-            p = np.divide(e0.conj(), mag, out=np.zeros_like(e0), where=mag > 0)
-            ph.append(np.roll(p, (-self.roll[0], -self.roll[1]), axis=(0, 1)))
-        # The inverse FFT onto the u-times finer grid normalises by u^2 too much: the
-        # factor rides on the phasors, saving a pass over the K images every frame.
-        self.phasors = np.stack(ph).astype(self.uc.dtype) * (self.u * self.u)
         self.pts = h0.points
         if suppress:
             self._init_tracking(views, med, dx * h0.x.size)
@@ -173,45 +157,21 @@ class StreamImager:
         self.theta = theta
         return model + (J @ step[..., None].astype(J.dtype))[..., 0]
 
-    def _embed(self, P: np.ndarray) -> np.ndarray:
-        """Zero-pad spectra into the image grid, reusing one buffer (see migrate)."""
-        if getattr(self, "_buf", None) is None or self._buf.shape[0] != P.shape[0]:
-            self._buf = _zero_pad_spectrum(P, self.u)
-        else:
-            My, Mx = P.shape[-2:]
-            u = self.u
-            hy, hx = (My + 1) // 2, (Mx + 1) // 2
-            b = self._buf
-            b[:, :hy, :hx] = P[:, :hy, :hx]
-            b[:, :hy, u * Mx - Mx // 2:] = P[:, :hy, Mx - Mx // 2:]
-            b[:, u * My - My // 2:, :hx] = P[:, My - My // 2:, :hx]
-            b[:, u * My - My // 2:, u * Mx - Mx // 2:] = P[:, My - My // 2:, Mx - Mx // 2:]
-            if My % 2 == 0:
-                b[:, My // 2, :] = b[:, u * My - My // 2, :] = 0.5 * b[:, u * My - My // 2, :]
-            if Mx % 2 == 0:
-                b[:, :, Mx // 2] = b[:, :, u * Mx - Mx // 2] = 0.5 * b[:, :, u * Mx - Mx // 2]
-        return self._buf
-
     # ------------------------------------------------------------------- a frame
     def __call__(self, data: np.ndarray) -> Image:
         """Image one frame: ``data`` of shape (K, ny, nx), the views in order."""
         h = np.asarray(data)
-        if h.shape != (self.phasors.shape[0], *self.shape):
-            raise ValueError(f"data must have shape {(self.phasors.shape[0], *self.shape)}, "
-                             f"got {h.shape}")
+        K = len(self.migrations)
+        if h.shape != (K, *self.shape):
+            raise ValueError(f"data must have shape {(K, *self.shape)}, got {h.shape}")
         flat = h.reshape(h.shape[0], -1).astype(complex, copy=False)
         if not np.all(np.isfinite(flat)):
             raise ValueError("data must be finite: the frame contains NaN or inf values")
         if self.suppress and np.any(flat):
             flat = flat - self._fit(flat)
-        H = self.op.spectrum(flat.reshape(h.shape))
-        P = H * self.uc
-        if self.u > 1:
-            P = self._embed(P)
-        g = sfft.ifft2(P, axes=(-2, -1), workers=fft_workers(P.shape[-2] * P.shape[-1]),
-                       overwrite_x=self.u == 1)
-        np.multiply(g, self.phasors, out=g)
-        img = g.sum(axis=0)
-        img = np.roll(img, self.roll, axis=(0, 1))
+        frame = flat.reshape(h.shape)
+        img = self.migrations[0].adjoint(frame[0])
+        for m, view in zip(self.migrations[1:], frame[1:], strict=True):
+            img += m.adjoint(view)
         return Image(img, self.x, self.y, np.array([self.z]), self.frequency,
                      "stream:coherent", has_z_axis=False)

@@ -36,7 +36,9 @@ from ..data.hologram import Hologram, Image
 from ..physics.incident import remove_incident_phase
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave
-from .migrate import _incident_phasor, migrate
+from .migrate import migrate
+from .migration.image import image_of
+from .migration.settings import MigrationSettings
 
 __all__ = ["align_phases", "synthesize"]
 
@@ -203,9 +205,13 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
         aligned = g  # migrate's own new array: the phase comes off in place
         remove_incident_phase(aligned, sources, k, med, img.x, img.y, img.z)
     else:
-        aligned = np.empty_like(g)
-        for i, v in enumerate(views):
-            aligned[i] = g[i] * _incident_phasor(v.source, k, med, img, v.pose)
+        # A raised or shifted level view: each imaged with its own incident phase
+        # removed (the migration operator's "phase" illumination, at the pixels'
+        # world positions).
+        one = MigrationSettings(upsample=upsample, fov=fov, illumination="phase", **where)
+        aligned = np.stack([image_of(v, img.z if img.has_z_axis else float(img.z[0]),
+                                     medium, one).data for v in views])
+        aligned = aligned if img.has_z_axis else aligned[:, None]
     return _combine(aligned, img, mode, return_views)
 
 

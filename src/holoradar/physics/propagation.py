@@ -33,6 +33,7 @@ import numpy as np
 from .._lazy import lazy_module
 from .._threads import fft_workers
 from .medium import FREE_SPACE, Medium
+from .spectra import fft2_padded, ifft2_cropped
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -47,6 +48,7 @@ __all__ = [
     "loss_exponent",
     "padded_shape",
     "spectral_axes",
+    "transfer_cache_bytes",
     "two_way_transfer",
 ]
 
@@ -85,22 +87,6 @@ def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[floa
     if factor == 1:
         return tuple(shape)
     return tuple(sfft.next_fast_len(int(np.ceil(factor * n)), real=False) for n in shape)
-
-
-def ifft2_cropped(A: np.ndarray, crop: tuple[int, int], workers: int = -1,
-                  overwrite: bool = False) -> np.ndarray:
-    """``ifft2(A)[..., :ny, :nx]`` without computing what the crop throws away.
-
-    Along x over every row, keep the first ``nx`` columns, then along y over those
-    only: on a grid padded twice, a quarter fewer 1-D transforms (about 0.73x the
-    time of the full inverse here).
-    """
-    ny, nx = crop
-    My, Mx = A.shape[-2:]
-    if (ny, nx) == (My, Mx):
-        return sfft.ifft2(A, axes=(-2, -1), workers=workers, overwrite_x=overwrite)
-    half = sfft.ifft(A, axis=-1, workers=workers, overwrite_x=overwrite)[..., :nx]
-    return sfft.ifft(half, axis=-2, workers=workers, overwrite_x=True)[..., :ny, :]
 
 
 def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndarray, np.ndarray]:
@@ -270,6 +256,11 @@ _CACHE = _TransferCache(256 * 2**20)
 def clear_transfer_cache() -> None:
     """Free the cached transfer functions (at most 256 MiB are kept)."""
     _CACHE.clear()
+
+
+def transfer_cache_bytes() -> int:
+    """The most bytes of transfer functions kept between calls (256 MiB)."""
+    return _CACHE.max_bytes
 
 
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
@@ -457,30 +448,8 @@ class _PlaneOperator(ABC):
         return fft_workers(self.fft_shape[0] * self.fft_shape[1])
 
     def _fft(self, a: np.ndarray, own: bool = False) -> np.ndarray:
-        """Padded 2-D FFT of ``a``; ``own``: ``a`` may be overwritten (a fresh copy).
-
-        Only the first 1-D pass writes new memory; the second runs in place. pocketfft's
-        out-of-place 2-D transform of a 512 x 512 plane costs ~0.3-0.5 ms more than a
-        1-D pass out of place then one in place (measured; a copy then an in-place 2-D
-        transform lies between), and a padded grid has its zeros written once.
-        """
-        My, Mx = self.fft_shape
-        ny, nx = a.shape[-2:]
-        if ny > My or nx > Mx:   # a grid cropped, not padded: the general route
-            return sfft.fft2(a, s=self.fft_shape, axes=(-2, -1), workers=self.workers)
-        if (ny, nx) == (My, Mx):
-            if own:
-                return sfft.fft2(a, axes=(-2, -1), workers=self.workers, overwrite_x=True)
-            rows = sfft.fft(a, axis=-1, workers=self.workers)   # the new array
-            return sfft.fft(rows, axis=-2, workers=self.workers, overwrite_x=True)
-        # Padded: along x over the recorded rows only (the padding rows are zeros and
-        # stay zeros), then along y, both in place in the zero-padded output.
-        out = np.zeros((*a.shape[:-2], My, Mx), dtype=self.dtype)
-        out[..., :ny, :nx] = a
-        rows = sfft.fft(out[..., :ny, :], axis=-1, workers=self.workers, overwrite_x=True)
-        if not np.may_share_memory(rows, out):   # overwrite_x is a hint, not a promise
-            out[..., :ny, :] = rows
-        return sfft.fft(out, axis=-2, workers=self.workers, overwrite_x=True)
+        """Padded 2-D FFT of ``a``; ``own``: ``a`` may be overwritten (a fresh copy)."""
+        return fft2_padded(a, self.fft_shape, self.dtype, self.workers, own)
 
     def _ifft_crop(self, A: np.ndarray) -> np.ndarray:
         return ifft2_cropped(A, self.shape, self.workers)

@@ -33,21 +33,17 @@ import numpy as np
 from scipy.optimize import minimize
 
 from ...data.hologram import Hologram
-from ...imaging.migrate import _data_snr, _weights, migrate
+from ...imaging.migration.image import Migration
+from ...imaging.migration.settings import MigrationSettings
 from ...imaging.point_response import PointResponse
 from ...physics.medium import Medium
 from .errors import HologramFitError
 from .grid import Volume
-from .kimage import SpectralSum
 
 __all__ = ["CHECK_PLANES", "HologramModel"]
 
 CHECK_PLANES = 5
 """Planes of a volume on which the image is checked to be the hologram's migration."""
-
-SUM_TOL = 1e-9
-"""The frequencies' sum must equal ``migrate`` on the checked planes to this fraction of
-the image's peak (rounding: ~1e-15) to be used for the objects' images."""
 
 SEARCH_TOL = 0.01
 """Nelder-Mead's position tolerance, in resolution cells (Gauss-Newton goes on)."""
@@ -108,12 +104,9 @@ class HologramModel:
         self.medium = medium
         opts = dict(options or {})
         opts.setdefault("upsample", u)
-        if hologram.is_wideband and isinstance(opts.get("equalize", True), bool | np.bool_):
-            # The weights of the original hologram: the residual's would differ.
-            opts["equalize"] = _weights(hologram, opts.get("equalize", True))
-        if opts.get("snr_db") is None:
-            opts["snr_db"] = _data_snr(hologram, medium, volume.z)
         self.options = opts
+        self.migration = _frozen(hologram, volume, medium, opts)
+        self._subsets: dict[tuple[int, ...], Migration] = {}
         self.eps = {}
         # Free space as a "ground" of eps 1 + 1e-6 from half the image's first range (eps
         # exactly 1 puts a quadrature node on the Green integral's branch point; the
@@ -128,20 +121,24 @@ class HologramModel:
         self.h = hologram.data.reshape(hologram.nf, -1).astype(complex)
         self.res = self.h.copy()
         self.objects: list[dict[str, Any]] = []
-        self._sum: SpectralSum | None = None
 
     # ------------------------------------------------------------------ images
     def image(self, data: np.ndarray, planes: np.ndarray | None = None) -> np.ndarray:
         """The migration of hologram data (nf, N) with the image's settings, (nz, ny, nx)
-        (``planes``: only those plane indices, (len(planes), ny, nx))."""
-        if self._sum is not None and planes is None:
-            return self._sum.image(data)
-        h = self.hologram.with_data(data.reshape(self.hologram.data.shape))
-        z = self.vol.z if not self.vol.planar else float(self.vol.z[0])
+        (``planes``: only those plane indices, (len(planes), ny, nx)).
+
+        The migration operator frozen on the original hologram (its frequency weights
+        and the loss compensation's SNR), so that the image of a residual is the
+        residual image: linear in the data."""
+        d = data.reshape(self.hologram.data.shape)
+        m = self.migration
         if planes is not None and not self.vol.planar:
-            z = self.vol.z[planes]
-        img = migrate(h, z, medium=self.medium, **self.options)
-        out = np.asarray(img.data)
+            key = tuple(int(i) for i in planes)
+            if key not in self._subsets:
+                self._subsets[key] = Migration(self.hologram, self.vol.z[list(key)],
+                                               self.medium, m.settings)
+            m = self._subsets[key]
+        out = m.adjoint(d)
         return out[None] if self.vol.planar else out
 
     def check_planes(self) -> np.ndarray:
@@ -174,21 +171,7 @@ class HologramModel:
                                    f"{err:.2g} of the peak); pass the migration's other "
                                    "options as migrate_options={...}, or leave hologram out",
                                    "mismatch", err)
-        self._sum = self._spectral_sum(img, planes, scale)
         return self.vol.data.copy()
-
-    def _spectral_sum(self, img: np.ndarray, planes: np.ndarray, scale: float
-                      ) -> SpectralSum | None:
-        """The frequencies' sum (:mod:`.kimage`) where it applies and reproduces
-        ``migrate``'s planes ``img`` to rounding (:data:`SUM_TOL` of the peak)."""
-        if self.vol.planar or not self.hologram.is_wideband:
-            return None
-        try:
-            ks = SpectralSum(self.hologram, self.vol.z, self.medium, self.options)
-        except ValueError:
-            return None
-        err = float(np.max(np.abs(ks.image(self.res, planes) - img))) / scale
-        return ks if err < SUM_TOL else None
 
     # ----------------------------------------------------------------- the fit
     def _eps_at(self, z: float) -> float:
@@ -378,3 +361,19 @@ class HologramModel:
             except np.linalg.LinAlgError:
                 out.append(np.full(3, np.nan))
         return out
+
+
+def _frozen(hologram: Hologram, volume: Volume, medium: Medium | None,
+            options: dict[str, Any]) -> Migration:
+    """The image's migration with its data-derived settings fixed to the original
+    hologram's: the frequency weights (``equalize=True``: the residual's would differ)
+    and the loss compensation's SNR."""
+    z = volume.z if not volume.planar else float(volume.z[0])
+    first = Migration(hologram, z, medium, MigrationSettings.of(**options))
+    plan = first.plan
+    fixed: dict[str, Any] = {}
+    if hologram.is_wideband:
+        fixed["equalize"] = tuple(float(w) for w in plan.weights)
+    if plan.compensates:
+        fixed["snr_db"] = plan.snr_db
+    return Migration(hologram, z, medium, first.settings.replace(**fixed)) if fixed else first

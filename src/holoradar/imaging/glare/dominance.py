@@ -109,7 +109,8 @@ def glare_share(hologram: Hologram, image: Image, medium: Medium | None, *,
     >>> glare_share(h, img, sand).dominates
     True
     """
-    from ...imaging.migrate import _data_snr, migrate
+    from ..migration.image import Migration
+    from ..migration.settings import MigrationSettings
     from .suppress import suppress_surface
 
     src = source if source is not None else hologram.source
@@ -128,12 +129,14 @@ def glare_share(hologram: Hologram, image: Image, medium: Medium | None, *,
             warnings.simplefilter("ignore")
             clean, rep = suppress_surface(hologram, medium, src, "gaussian", direct=True)
             removed = hologram.with_data(hologram.data - clean.data)
-            # one loss-compensation filter for both parts: the imaging stays linear
-            opts = {**migrate_options, "progress": False}
-            if opts.get("compensate_loss", True) and opts.get("snr_db") is None:
-                opts["snr_db"] = _data_snr(hologram, medium, zs)
-            whole = migrate(hologram, z_p, medium=medium, **opts)
-            glare = migrate(removed, z_p, medium=medium, **opts)
+            # One frozen operator for both parts (the loss compensation's SNR from the
+            # whole hologram, on the image's planes): the imaging stays linear.
+            settings = MigrationSettings.of(**{**migrate_options, "progress": False})
+            if settings.compensate_loss and settings.snr_db is None:
+                snr = Migration(hologram, zs, medium, settings).plan.snr_db
+                settings = settings.replace(snr_db=snr)
+            m = Migration(hologram, z_p, medium, settings)
+            whole, glare = m.image(hologram.data), m.image(removed.data)
     except ValueError:
         return None
     # the pixel of the brightest voxel on this plane's grid (the same grid, made alike)

@@ -2,9 +2,9 @@
 
 Holds the public entry point with its report (:class:`SuppressionReport`) and
 warning (:class:`FitWarning`), the ``"cut"`` and ``"background"`` methods, the
-mirror-plane image and spot search (``_mirror_*``, ``_grid_coords``,
-``_find_spot``) and the argument checks (``_check``); the model fits live in
-:mod:`.beams` and :mod:`.image_source`.
+mirror-plane image (the migration operator onto the mirror plane) and spot search
+(``_mirror_*``, ``_find_spot``) and the argument checks (``_check``); the model fits
+live in :mod:`.beams` and :mod:`.image_source`.
 """
 
 from __future__ import annotations
@@ -15,18 +15,16 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ..._lazy import lazy_module
 from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
 from ...physics.medium import Medium
-from ...physics.propagation import AngularSpectrum
 from ...physics.sources import GaussianBeam, PointSource
 from ...theory import lateral_resolution
+from ..migration.image import Migration
+from ..migration.settings import MigrationSettings
 from ._common import _direct_wave, _joint_direct, _recorded, _require_direct_wave
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source
-
-sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = ["FitWarning", "SuppressionReport", "suppress_surface"]
 
@@ -93,32 +91,22 @@ def _db(a: float, b: float) -> float:
     return float(10 * np.log10(max(a, 1e-300) / max(b, 1e-300)))
 
 
-def _mirror_operator(h: Hologram, z_m: float) -> AngularSpectrum:
-    dx, dy = h.pitch
-    return AngularSpectrum(h.data.shape[-2:], dx, dy, h.k, z_m, None, True)
+def _mirror_operator(h: Hologram, z_m: float) -> Migration:
+    """Free-space migration to the mirror plane z_m over the whole padded grid (the
+    mirror source may lie beside the array), in double precision."""
+    return Migration(h, z_m, None, MigrationSettings(fov="full", compensate_loss=False,
+                                                     dtype=np.complex128, progress=False))
 
 
-def _mirror_image(op: AngularSpectrum, data: np.ndarray) -> np.ndarray:
-    """Free-space back-propagation to z_m on the whole padded grid (no crop)."""
-    H = op.spectrum(data)
-    return sfft.ifft2(H * op.adjoint_transfers[0], axes=(-2, -1), workers=op.workers)
+def _mirror_image(op: Migration, data: np.ndarray) -> np.ndarray:
+    """The mirror plane's image of ``data`` (its grid: ``op.x``, ``op.y``)."""
+    return op.adjoint(data)
 
 
-def _grid_coords(h: Hologram, op: AngularSpectrum) -> tuple[np.ndarray, np.ndarray]:
-    """Coordinates of the padded grid's samples, unwrapped around the aperture."""
-    My, Mx = op.fft_shape
-    dx, dy = h.pitch
-    ix = np.arange(Mx)
-    iy = np.arange(My)
-    ix = np.where(ix < Mx - (Mx - h.x.size) // 2, ix, ix - Mx)
-    iy = np.where(iy < My - (My - h.y.size) // 2, iy, iy - My)
-    return h.x[0] + ix * dx, h.y[0] + iy * dy
-
-
-def _find_spot(h: Hologram, op: AngularSpectrum, E: np.ndarray, guess: np.ndarray,
+def _find_spot(op: Migration, E: np.ndarray, guess: np.ndarray,
                radius: float) -> tuple[float, float, float]:
     """Peak of |E| within ``radius`` of the predicted mirror position."""
-    gx, gy = _grid_coords(h, op)
+    gx, gy = op.x, op.y
     a = np.abs(E.reshape((-1, *E.shape[-2:]))).max(axis=0)
     near = np.hypot(gx[None, :] - guess[0], gy[:, None] - guess[1]) <= radius
     if not near.any():
@@ -284,7 +272,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     cell = lateral_resolution(hologram.wavelength, z_m, min(A))
     predicted = mirror_local[:2]
     E_before = _mirror_image(op, data)
-    xs, ys, peak_before = _find_spot(hologram, op, E_before, predicted, 3 * cell)
+    xs, ys, peak_before = _find_spot(op, E_before, predicted, 3 * cell)
     pol = _recorded(hologram, src)
     D = _direct_wave(src, k, pts, pol) if direct else None
     h = data.ravel()
@@ -297,7 +285,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
             # the reflected beam's spot is its waist blurred by the aperture: cover
             # two waists (the beam's amplitude there is e^-4, -35 dB)
             r = float(np.hypot(1.5 * cell, 2 * src.waist))
-        gx, gy = _grid_coords(hologram, op)
+        gx, gy = op.x, op.y
         dist = np.hypot(gx[None, :] - xs, gy[:, None] - ys)
         if taper:
             mask = np.clip((1.5 * r - dist) / (0.5 * r), 0, 1)
@@ -305,10 +293,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         else:
             mask = (dist <= r).astype(float)
         def bite(v: np.ndarray) -> np.ndarray:
-            E = _mirror_image(op, v.reshape(data.shape))
-            back = sfft.ifft2(sfft.fft2(E * mask, workers=op.workers) * op.transfers[0],
-                              workers=op.workers)
-            return back[:data.shape[0], :data.shape[1]].ravel()
+            # The masked spot carried back to the aperture: the operator's forward map.
+            return op.forward(_mirror_image(op, v.reshape(data.shape)) * mask).ravel()
 
         glare = bite(h)
         dcoef, glare, direct_part = _joint_direct(h, glare, D)
@@ -323,7 +309,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     elif method == "gaussian":
         transform = None
         if fit_domain == "mirror":
-            gx, gy = _grid_coords(hologram, op)
+            gx, gy = op.x, op.y
             window = np.hypot(gx[None, :] - xs, gy[:, None] - ys) <= 2 * cell
 
             def transform(v: np.ndarray) -> np.ndarray:
@@ -352,7 +338,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         converged, params = fit["converged"], fit
     cleaned = h - glare - direct_part
     E_after = _mirror_image(op, cleaned.reshape(data.shape))
-    _, _, peak_after = _find_spot(hologram, op, E_after, np.array([xs, ys]), 0.5 * cell)
+    _, _, peak_after = _find_spot(op, E_after, np.array([xs, ys]), 0.5 * cell)
     left = float(np.sum(np.abs(cleaned) ** 2))
     report_kw.update(
         glare_suppression_db=2 * _db(peak_before, peak_after),  # amplitudes: 20 log10

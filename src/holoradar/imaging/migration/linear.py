@@ -1,0 +1,217 @@
+"""The migration operator as a ``scipy.sparse.linalg.LinearOperator``.
+
+``A = migration_operator(hologram, z, medium=...)`` maps a reflectivity ``r`` on the
+image grid (planes ``z``, the image's pixels) to the hologram's samples,
+
+    h_f = w_f sum_z U_f(z) [ psi_f(., z) r(., z) ],
+
+``U_f(z)`` the exact propagation from plane z to the aperture through the layers
+(the round trip for a scanned transceiver), ``psi_f`` the source's incident field
+(``illumination``), ``w_f`` the frequency weights: the Kirchhoff/Born model of a
+reflecting plane in :func:`holoradar.simulate` (its planar targets). ``A.H`` is its
+exact adjoint: with ``migrate``'s settings (``compensate_loss=True``,
+``equalize=True``, ``illumination=None``) ``A.H @ h`` is ``migrate(h, z)``. scipy's
+``lsqr``, ``lsmr`` and ``cg`` take ``A`` as it is, PyLops's solvers through
+``pylops.aslinearoperator(A)``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from scipy.sparse.linalg import LinearOperator
+
+from ...data.hologram import Hologram, Image
+from .backend import Backend
+from .choose import choose
+from .plan import MigrationPlan, make_plan
+from .settings import MigrationSettings
+
+__all__ = ["MigrationOperator", "migration_operator"]
+
+#: What the operator models unless told otherwise: the physics, not migrate's filter.
+OPERATOR_DEFAULTS = {"compensate_loss": False, "equalize": False, "illumination": "field"}
+
+
+def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
+                       settings: MigrationSettings | None = None,
+                       **options: Any) -> MigrationOperator:
+    """The linear map from a reflectivity on the image grid to ``hologram``'s samples.
+
+    Parameters
+    ----------
+    hologram : Hologram
+        The measurement's geometry: grid, frequencies, source, pose, polarisation,
+        transceiver or receiver array (its data set the weights ``equalize=True``
+        and the SNR of the loss compensation, once; otherwise they are not used).
+    z : float or sequence of float
+        Ranges of the image planes, metres (``frame="ground"``: world ranges).
+    medium : Medium, optional
+        The layered ground (None: free space).
+    settings : MigrationSettings, optional
+        All options at once (``options`` then replace some of its fields).
+    **options
+        :func:`holoradar.migrate`'s options (``method``, ``pad``, ``upsample``,
+        ``fov``, ``frame``, ``x``, ``y``, ``dtype``, ``combine`` ("coherent" or "none"),
+        ``algorithm``, ``snr_db``), and ``illumination`` ("field", "phase" or
+        "none"), ``compensate_loss``, ``equalize``. Their defaults here describe the
+        physics: ``illumination="field"`` (the source's incident field), no loss
+        compensation, unit frequency weights. Give ``compensate_loss=True,
+        equalize=True, illumination=None`` for the operator whose adjoint is
+        ``migrate``'s image.
+
+    Returns
+    -------
+    MigrationOperator
+        Shape ``(hologram samples, image voxels)``; ``.image_shape``, ``.coords``,
+        ``.to_image(vector)``.
+
+    Raises
+    ------
+    ValueError
+        A bad option, a grid the chosen backend cannot represent (e.g.
+        ``algorithm="kspace"`` on non-uniform planes), ``combine="incoherent"``
+        (not linear).
+
+    Examples
+    --------
+    >>> import numpy as np, holoradar as hr
+    >>> scene = hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))], source=hr.PlaneWave())
+    >>> h = hr.simulate(scene, hr.Aperture.grid(16, 0.01), 9.9e9)
+    >>> A = hr.migration_operator(h, [0.25, 0.3])
+    >>> A.shape, A.image_shape
+    ((256, 512), (2, 16, 16))
+    >>> rng = np.random.default_rng(0)
+    >>> r = rng.standard_normal(512) + 1j * rng.standard_normal(512)
+    >>> d = rng.standard_normal(256) + 1j * rng.standard_normal(256)
+    >>> bool(np.isclose(np.vdot(A @ r, d), np.vdot(r, A.H @ d), rtol=1e-12))
+    True
+    """
+    given = dict(options)
+    if settings is None:
+        given = {**{k: v for k, v in OPERATOR_DEFAULTS.items() if k not in given}, **given}
+    s = MigrationSettings.of(settings, **given)
+    if s.combine == "incoherent":
+        raise ValueError("combine='incoherent' is not linear (the root sum of squares of "
+                         "the frequencies' images): give combine='coherent' or 'none'")
+    plan = make_plan(hologram, z, medium, s)
+    return MigrationOperator(plan, choose(plan))
+
+
+class MigrationOperator(LinearOperator):
+    """One geometry's migration operator (:func:`migration_operator` makes it).
+
+    Parameters
+    ----------
+    plan : MigrationPlan
+        The geometry and settings, fixed.
+    backend : Backend
+        What computes it.
+
+    Attributes
+    ----------
+    plan : MigrationPlan
+    backend : Backend
+    image_shape : tuple of int
+        ``(nz, ny', nx')``, or ``(nf, nz, ny', nx')`` with ``combine="none"``.
+    data_shape : tuple of int
+        One frame's samples: ``(nf, ny, nx)`` for a band, ``(ny, nx)`` for one frequency.
+    x, y : ndarray
+        The image's pixel coordinates, metres.
+    """
+
+    def __init__(self, plan: MigrationPlan, backend: Backend) -> None:
+        self.plan = plan
+        self.backend = backend
+        self.x, self.y = backend.axes(plan)
+        nz = plan.z.size
+        self.image_shape = ((plan.nf,) if plan.separate else ()) + (nz, self.y.size,
+                                                                    self.x.size)
+        self.data_shape = plan.data_shape
+        super().__init__(dtype=plan.work, shape=(math.prod(self.data_shape),
+                                                 math.prod(self.image_shape)))
+
+    # ------------------------------------------------------------------ checked entry
+    def matvec(self, x: Any) -> np.ndarray:
+        """Forward: a reflectivity (``image_shape`` voxels, flat) -> the samples (flat)."""
+        return super().matvec(self._checked(x, "x", self.shape[1], self.image_shape))
+
+    def rmatvec(self, x: Any) -> np.ndarray:
+        """Adjoint: samples (flat) -> the back-propagated image (flat)."""
+        return super().rmatvec(self._checked(x, "x", self.shape[0], self.data_shape))
+
+    def _checked(self, x: Any, name: str, n: int, shape: tuple[int, ...]) -> np.ndarray:
+        arr = np.asanyarray(x)
+        if arr.dtype.kind not in "biufc":
+            raise ValueError(f"{name} must be a numeric vector of {n} values (shape {shape} "
+                             f"flattened), got dtype {arr.dtype}")
+        if arr.shape not in ((n,), (n, 1)):
+            raise ValueError(f"{name} must be a vector of {n} values (shape {shape} "
+                             f"flattened, C order), got shape {arr.shape}")
+        return arr
+
+    # ------------------------------------------------------------------ the maps
+    def _apply_forward(self, X: np.ndarray) -> np.ndarray:
+        """Columns of reflectivities ``(N, k)`` -> columns of samples ``(M, k)``."""
+        k = X.shape[1]
+        img = np.ascontiguousarray(X.T).astype(self.plan.work, copy=False)
+        out = self.backend.forward(self.plan, img.reshape((k, *self.image_shape)))
+        return out.reshape(k, -1).T
+
+    def _apply_adjoint(self, Y: np.ndarray) -> np.ndarray:
+        k = Y.shape[1]
+        data = np.ascontiguousarray(Y.T).astype(self.plan.work, copy=False)
+        out = self.backend.adjoint(self.plan, data.reshape((k, self.plan.nf, *self.plan.grid)))
+        return out.reshape(k, -1).T
+
+    def _matvec(self, x: np.ndarray) -> np.ndarray:
+        return self._apply_forward(x.reshape(-1, 1))[:, 0]
+
+    def _rmatvec(self, x: np.ndarray) -> np.ndarray:
+        return self._apply_adjoint(x.reshape(-1, 1))[:, 0]
+
+    def _matmat(self, X: np.ndarray) -> np.ndarray:
+        return self._apply_forward(X)
+
+    def _rmatmat(self, X: np.ndarray) -> np.ndarray:
+        return self._apply_adjoint(X)
+
+    # ------------------------------------------------------------------ conveniences
+    @property
+    def coords(self) -> dict[str, np.ndarray]:
+        """The image's axes, metres (and ``frequency``, Hz, with ``combine="none"``)."""
+        out = {"z": self.plan.z.copy(), "y": self.y.copy(), "x": self.x.copy()}
+        if self.plan.separate:
+            out = {"frequency": self.plan.geometry.frequencies.copy(), **out}
+        return out
+
+    def to_image(self, vector: Any) -> Image:
+        """A vector of ``image_shape`` voxels (a reflectivity, or ``A.H @ h``) as an Image."""
+        v = self._checked(vector, "vector", self.shape[1], self.image_shape)
+        g = self.plan.geometry
+        data = np.asarray(v).reshape(self.image_shape)
+        freq = g.frequencies.copy() if g.is_wideband else g.frequency
+        return Image(data, self.x, self.y, self.plan.z, freq, f"operator:{self.backend.name}")
+
+    def to_hologram(self, vector: Any) -> Hologram:
+        """A vector of samples (``A @ r``) as a Hologram of this geometry."""
+        v = self._checked(vector, "vector", self.shape[0], self.data_shape)
+        g = self.plan.geometry
+        return Hologram(np.asarray(v).reshape(self.data_shape), g.x, g.y, g.frequency,
+                        source=g.source, monostatic=g.monostatic, pose=g.pose,
+                        polarization=g.polarization)
+
+    def vector(self, hologram: Hologram) -> np.ndarray:
+        """A hologram of this geometry (one frame) as the flat vector ``A.H`` takes."""
+        if not isinstance(hologram, Hologram) or hologram.data.shape != self.data_shape:
+            raise ValueError(f"hologram must be a holoradar.Hologram of one frame of shape "
+                             f"{self.data_shape}, got "
+                             f"{getattr(getattr(hologram, 'data', None), 'shape', hologram)!r}")
+        return hologram.data.reshape(-1)
+
+    def __repr__(self) -> str:
+        return (f"<MigrationOperator {self.shape[0]} samples x {self.shape[1]} voxels, "
+                f"image {self.image_shape}, backend {self.backend.name!r}, "
+                f"{self.dtype}>")

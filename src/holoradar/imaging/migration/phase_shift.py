@@ -1,0 +1,137 @@
+"""Uniform planes in the deepest layer: the phase-shift sum (``"kspace"``), compiled
+(``"columns"``) or resampled (``"stolt"``).
+
+Below the last interface each plane wave's transfer grows from plane to plane by one
+factor, so a band's coherent sum is carried from plane to plane in the wavenumber
+domain (:mod:`holoradar.imaging.kspace`, :mod:`holoradar.imaging.columns`,
+:mod:`holoradar.imaging.stolt`). The three share what they need and refuse alike:
+uniformly spaced planes in the deepest region, the exact angular spectrum on the
+aperture's own footprint, a coherent sum, an illumination the same across each plane
+(a transceiver, or a plane wave at normal incidence, or none) and no loss to
+compensate. Their forward maps are the exact adjoints of what each computes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import columns, kspace, stolt
+from . import illumination
+from .backend import Backend, uniform_planes
+from .plan import MigrationPlan
+
+__all__ = ["Columns", "PhaseShift", "Stolt"]
+
+
+class PhaseShift(Backend):
+    """The phase-shift sum in NumPy (the reference of the compiled loop)."""
+
+    name = "kspace"
+    tiny = kspace._TINY
+
+    def refuses(self, plan: MigrationPlan) -> str | None:
+        why = self._needs(plan)
+        return "; ".join(why) if why else None
+
+    def _needs(self, plan: MigrationPlan) -> list[str]:
+        s = plan.settings
+        why = []
+        if s.method != "angular":
+            why.append(f"method='angular' (got {s.method!r})")
+        if s.fov != "aperture":
+            why.append(f"fov='aperture' (got {s.fov!r})")
+        if plan.separate:
+            why.append(f"combine='coherent' (got {s.combine!r})")
+        if s.frame != "aperture":
+            why.append("the aperture's own frame (frame='aperture')")
+        elif plan.nf > 1 and not plan.geometry.pose.is_identity:
+            why.append("an untilted aperture at z = 0 (hologram.pose the identity)")
+        if not uniform_planes(plan.z):
+            why.append("two or more uniformly spaced planes, increasing")
+        last = plan.local.n_regions - 1
+        if np.any(np.asarray(plan.local.region_of(plan.z)) != last):
+            why.append(f"all planes in the deepest layer (z >= {plan.local.z_interfaces[-1]} "
+                       "m): one kz per column")
+        if plan.compensates:
+            lossy = sum(complex(e).imag != 0 for e in plan.medium.eps)
+            why.append(f"no loss to compensate ({lossy} lossy layer(s); give "
+                       "compensate_loss=False)")
+        if not illumination.is_uniform(plan):
+            src = type(plan.geometry.source).__name__
+            why.append("a transceiver, or a receiver array lit by a plane wave at normal "
+                       f"incidence (hologram.source is {src}: its incident phase varies "
+                       "across each plane)")
+        return why
+
+    def _incident(self, plan: MigrationPlan) -> str:
+        return "none" if plan.monostatic else plan.illumination
+
+    def _args(self, plan: MigrationPlan) -> tuple:
+        g = plan.geometry
+        return (g.pitch, plan.wavenumbers, plan.z, plan.local, g.monostatic, plan.weights)
+
+    def _options(self, plan: MigrationPlan) -> dict:
+        return {"pad": plan.pad, "upsample": plan.settings.upsample, "work": plan.work,
+                "incident": self._incident(plan)}
+
+    def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+        return kspace.adjoint_kspace(data, *self._args(plan), **self._options(plan))
+
+    def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+        return kspace.forward_kspace(image, plan.grid, *self._args(plan),
+                                     **self._options(plan), tiny=self.tiny)
+
+    def axes(self, plan: MigrationPlan) -> tuple[np.ndarray, np.ndarray]:
+        g = plan.geometry
+        dx, dy = g.pitch
+        u = plan.settings.upsample
+        ny, nx = plan.grid
+        return (g.x[0] + np.arange(u * (nx - 1) + 1) * dx / u,
+                g.y[0] + np.arange(u * (ny - 1) + 1) * dy / u)
+
+    def method(self, plan: MigrationPlan) -> str:
+        return "kspace" if plan.geometry.is_wideband else "angular"
+
+
+class Columns(PhaseShift):
+    """The phase-shift sum by a compiled loop over the spectral columns (numba)."""
+
+    name = "columns"
+
+    def refuses(self, plan: MigrationPlan) -> str | None:
+        why = self._needs(plan)
+        if not columns.available():
+            why.append("numba (not installed)")
+        return "; ".join(why) if why else None
+
+    def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+        return columns.adjoint_columns(data, *self._args(plan), **self._options(plan))
+
+    def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+        return kspace.forward_kspace(image, plan.grid, *self._args(plan),
+                                     **self._options(plan), tiny=columns.TINY[plan.work.char])
+
+
+class Stolt(PhaseShift):
+    """Stolt's migration: each column's plane waves resampled onto a uniform kz grid,
+    then one FFT along z (each plane wave within 0.9 % of the exact sum)."""
+
+    name = "stolt"
+
+    def refuses(self, plan: MigrationPlan) -> str | None:
+        why = self._needs(plan)
+        if plan.nf < 2:
+            why.append("several frequencies")
+        if not plan.monostatic and plan.geometry.source is None:
+            why.append("a receiver array's hologram.source (without it the incident "
+                       "phase of each frequency cannot be compensated)")
+        return "; ".join(why) if why else None
+
+    def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+        return stolt.adjoint_stolt(data, *self._args(plan), **self._options(plan))
+
+    def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+        return stolt.forward_stolt(image, plan.grid, *self._args(plan), **self._options(plan))
+
+    def method(self, plan: MigrationPlan) -> str:
+        return "stolt"
