@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging.oblique import sum_to_plane
+from holoradar.imaging.oblique_sum import sum_to_plane
 from holoradar.physics.green import layered_green
 from holoradar.theory import range_resolution
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import oblique
+from .. import oblique, oblique_sum
 from ..oblique import GroundGrid
 from . import illumination
 from .backend import Backend
@@ -95,12 +95,12 @@ class GroundNufft(GroundDirect):
         if plan.settings.frame != "ground":
             return "frame='ground'"
         g = plan.geometry
-        if not (oblique._uniform(g.x) and oblique._uniform(g.y)):
+        if not (oblique_sum._uniform(g.x) and oblique_sum._uniform(g.y)):
             return "elements on a uniform grid (finufft's modes)"
         return None
 
     def prefer(self, plan: MigrationPlan) -> bool:
         """Whether the measured costs favour it over the direct sums (``"auto"``)."""
         g = self.grids(plan)[0]
-        return oblique.choose_route(g.grid, plan.geometry.pose,
+        return oblique_sum.choose_route(g.grid, plan.geometry.pose,
                                     plan.geometry.data.shape[-2:]) == "nufft"
