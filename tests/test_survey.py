@@ -140,13 +140,13 @@ def test_rerun_resumes_without_redoing(survey_frames, tmp_path: Path,
                                        monkeypatch: pytest.MonkeyPatch) -> None:
     paths, holos = survey_frames
     calls = []
-    real = survey_worker.migrate
+    real = survey_worker.image_of
 
     def counting(*a, **kw):
         calls.append(1)
         return real(*a, **kw)
 
-    monkeypatch.setattr(survey_worker, "migrate", counting)
+    monkeypatch.setattr(survey_worker, "image_of", counting)
     store = tmp_path / "s.zarr"
     s1 = hr.survey.run_batch(paths[:10], store, z=Z, scheduler="synchronous")
     first = survey_store.read_index(store)["finished"].copy()

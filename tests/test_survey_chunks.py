@@ -99,7 +99,7 @@ def test_an_error_between_chunks_leaves_done_marks_matching_the_data(
     marked done; a rerun images the rest."""
     paths, holos = survey
     monkeypatch.setattr(survey_batch, "frames_per_chunk", lambda per, n: 4)
-    real = survey_worker.migrate
+    real = survey_worker.image_of
     calls = [0]
 
     def fails_on_the_seventh(*a, **kw):
@@ -108,7 +108,7 @@ def test_an_error_between_chunks_leaves_done_marks_matching_the_data(
             raise RuntimeError("out of memory (simulated)")
         return real(*a, **kw)
 
-    monkeypatch.setattr(survey_worker, "migrate", fails_on_the_seventh)
+    monkeypatch.setattr(survey_worker, "image_of", fails_on_the_seventh)
     store = tmp_path / "s.zarr"
     with pytest.raises(RuntimeError, match="simulated"):
         hr.survey.run_batch(paths, store, z=Z, workers=1)
@@ -116,7 +116,7 @@ def test_an_error_between_chunks_leaves_done_marks_matching_the_data(
     assert done.tolist() == [True] * 6 + [False] * 6
     idx = survey_store.read_index(store)
     assert np.isnan(survey_store.read_images(idx, range(6, 12))).all()
-    monkeypatch.setattr(survey_worker, "migrate", real)
+    monkeypatch.setattr(survey_worker, "image_of", real)
     s = hr.survey.run_batch(paths, store, z=Z, workers=1)
     assert (s["resumed"], s["done"]) == (6, 6) and _consistent(store, paths, holos).all()
 

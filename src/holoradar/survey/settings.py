@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import check_nonnegative_ranges
+from ..imaging.migration.settings import MigrationSettings
 from ..physics.medium import Medium
 
 __all__ = ["Settings"]
@@ -28,10 +29,9 @@ class Settings:
         Ranges of the image planes from the aperture, metres (1-D, >= 0).
     medium : Medium or None
         Layered ground (None: free space).
-    method : {"angular", "fresnel"}
-        Migration method.
-    upsample : int
-        Output pixels per element pitch.
+    migration : MigrationSettings
+        How each frame is migrated (its ``method`` and ``upsample`` are the survey's;
+        every other option is ``migrate``'s default).
 
     Examples
     --------
@@ -44,24 +44,29 @@ class Settings:
 
     z: np.ndarray
     medium: Medium | None
-    method: str
-    upsample: int
+    migration: MigrationSettings
+
+    @property
+    def method(self) -> str:
+        """Migration method, ``"angular"`` or ``"fresnel"``."""
+        return self.migration.method
+
+    @property
+    def upsample(self) -> int:
+        """Output pixels per element pitch."""
+        return self.migration.upsample
 
     @classmethod
     def make(cls, z: float | Sequence[float] | np.ndarray, medium: Medium | None, method: str,
              upsample: int) -> Settings:
-        """Validated settings (``ValueError`` on a bad value)."""
+        """Validated settings (``ValueError`` on a bad value, as ``migrate`` says it)."""
         zs = np.array(check_nonnegative_ranges(z, "z"), dtype=float).ravel()
         if medium is not None and not isinstance(medium, Medium):
             raise ValueError(f"medium must be a holoradar.Medium or None, got "
                              f"{type(medium).__name__}")
-        if method not in ("angular", "fresnel"):
-            raise ValueError(f"method must be 'angular' or 'fresnel', got {method!r}")
-        if isinstance(upsample, bool) or not isinstance(upsample, int | np.integer) \
-                or upsample < 1:
-            raise ValueError(f"upsample must be an integer >= 1, got {upsample!r}")
+        migration = MigrationSettings(method=method, upsample=upsample, progress=False)
         zs.setflags(write=False)
-        return cls(zs, medium, str(method), int(upsample))
+        return cls(zs, medium, migration)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form: numbers, lists and strings only (complex as ``[re, im]``)."""

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..data.hologram import Hologram
-from ..imaging.migrate import migrate
+from ..imaging.migration.image import image_of
 from ..io import load
 from .frames import FrameGeometry, frame_position
 from .schedule import stop_requested
@@ -87,8 +87,8 @@ def image_frame(path: str, name: str, job: Job) -> tuple[dict[str, Any], Any]:
     if holo is not None:
         s = job.settings
         try:
-            img = migrate(holo, s.z, medium=s.medium, method=s.method,  # type: ignore[arg-type]
-                          upsample=s.upsample, dtype=np.dtype(job.geometry.dtype))
+            img = image_of(holo, s.z, s.medium,
+                           s.migration.replace(dtype=np.dtype(job.geometry.dtype)))
         except ValueError as exc:
             problem = f"cannot be imaged: {exc}"
         else:

@@ -379,21 +379,21 @@ class ViewSession:
         """The image of the selected views at range(s) ``z``, and what the imaging warned
         about (an assumed illumination, say; the aliasing of the array's pitch is known
         and said in the page's info)."""
-        from ...imaging.migrate import migrate
+        from ...imaging.migration.image import image_of
         from ...imaging.synthesis import synthesize
 
         views, _ = self.cleaned(s)
         use = [views[i] for i in self.selected(s)]
         medium = self.medium(s)
-        combine = s.frequency if s.frequency in ("coherent", "incoherent") else "coherent"
-        kw: dict[str, Any] = {"upsample": s.upsample, "frame": s.frame}
-        if s.frame == "aperture":
-            kw["fov"] = s.fov
+        how = s.migration()
+        kw: dict[str, Any] = {"upsample": how.upsample, "frame": how.frame}
+        if how.frame == "aperture":
+            kw["fov"] = how.fov
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             if len(use) == 1:
-                img = migrate(use[0], z, medium=medium, combine=combine, **kw)
-            elif combine == "incoherent" and use[0].is_wideband:
+                img = image_of(use[0], z, medium, how)
+            elif how.combine == "incoherent" and use[0].is_wideband:
                 raise ValueError("views.frequency: the incoherent sum of frequencies is "
                                  "for one view; several views add their coherent images "
                                  "(choose 'coherent' or one frequency)")
@@ -468,7 +468,7 @@ class ViewSession:
     def mirror_plane(self, s: ViewSettings) -> Image:
         """The first selected view back-propagated in air to its mirror-source plane, where
         the surface glare focuses (after suppression when ``s.glare`` is on)."""
-        from ...imaging.migrate import migrate
+        from ...imaging.migration.image import image_of
 
         i, zm = self.mirror_source(s)
         views, _ = self.cleaned(s)
@@ -477,7 +477,8 @@ class ViewSession:
             # in the array's own frame: mirror_source took an array facing the ground
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                return migrate(views[i], zm, upsample=s.upsample, fov=s.fov)
+                return image_of(views[i], zm, None, s.migration().replace(
+                    frame="aperture", fov=s.fov, combine="coherent"))
 
         return self._planes.get(("mirror", self._glare_key(s), i, s.upsample, s.fov), make)
 

@@ -43,6 +43,8 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ...imaging.migration.settings import MigrationSettings, check_choice, check_upsample
+
 __all__ = ["GLARE_METHODS", "MODES", "ViewSettings", "read_settings", "settings_toml"]
 
 GLARE_METHODS = ("off", "gaussian", "image_source", "cut")
@@ -87,6 +89,22 @@ class ViewSettings:
                 object.__setattr__(self, name, tuple(v))
         _check(self)
 
+    def migration(self) -> MigrationSettings:
+        """How these settings migrate a view: ``migrate``'s options (a coherent band
+        unless ``frequency`` is "incoherent"; the field of view in the aperture's own
+        frame only; no progress bar in a page).
+
+        Examples
+        --------
+        >>> ViewSettings(upsample=2, fov="aperture").migration().fov
+        'aperture'
+        """
+        return MigrationSettings(
+            upsample=self.upsample, frame=self.frame,
+            fov=self.fov if self.frame == "aperture" else "aperture",
+            combine="incoherent" if self.frequency == "incoherent" else "coherent",
+            progress=False)
+
     def replace(self, **changes: Any) -> ViewSettings:
         """A copy with ``changes`` (checked like the constructor's arguments)."""
         return replace(self, **changes)
@@ -105,13 +123,10 @@ def _check(s: ViewSettings) -> None:
         _fail("files", "a list of file names", s.files)
     if not _finite(s.depth):
         _fail("image.depth", "a depth in metres", s.depth)
-    if s.frame not in ("aperture", "ground"):
-        _fail("image.frame", "'aperture' or 'ground'", s.frame)
-    if not isinstance(s.upsample, int) or isinstance(s.upsample, bool) or \
-            not 1 <= s.upsample <= 16:
-        _fail("image.upsample", "an integer from 1 to 16", s.upsample)
-    if s.fov not in ("full", "aperture"):
-        _fail("image.fov", "'full' or 'aperture'", s.fov)
+    # The imaging options are migrate's own, checked by the same functions.
+    check_choice(s.frame, "image.frame", ("aperture", "ground"))
+    check_upsample(s.upsample, "image.upsample", top=16)
+    check_choice(s.fov, "image.fov", ("full", "aperture"))
     if s.sweep is not None and not (isinstance(s.sweep, tuple | list) and len(s.sweep) == 2
                                     and all(map(_finite, s.sweep))
                                     and s.sweep[1] > s.sweep[0]):
