@@ -3,7 +3,7 @@ the data's spectrum on the reference plane (finufft's type-2 non-uniform FFT and
 the hand-written factored sums), and the whole path against the frontal FFT
 migration of the same data onto the same grid, cold and warm.
 
-Part 1, the spectrum (``oblique._spectrum_on_plane``), both routes on the same
+Part 1, the spectrum (``oblique_sum.sum_to_plane``), both routes on the same
 grids: the tests' size (10 x 8 elements onto a 40 x 44 grid), 16 x 16 onto 64 x 64
 pixels, the issue's case
 (32 x 32 at lambda/2 and 9.9 GHz, tilted 35 degrees over sand, onto the world grid
@@ -12,10 +12,10 @@ degrees, factored in full), and larger arrays (64 x 64 onto 256 x 256, both azim
 128 x 128 onto 384 x 384 at azimuth 90 degrees: at 30 degrees the direct route's factors
 alone would take several GB).
 Warm: the geometry's factors cached, the median of REPEAT interleaved calls.
-Cold: the first call of ``migrate_ground`` in a fresh Python process (imports of
+Cold: the first ground-frame ``migrate`` in a fresh Python process (imports of
 holoradar done, of finufft not), the median of COLD_RUNS processes alternating
 the routes. Agreement: relative L2 of the nufft spectrum against the direct one;
-"auto": the route ``oblique.choose_route`` takes there (the default).
+"auto": the route ``oblique_sum.choose_route`` takes there (the default).
 
 Part 2, the issue's case end to end (one plane, a 64-plane volume) with the default
 route and with each route forced, against the frontal migration onto the same
@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 import holoradar as hr
-from holoradar.imaging import oblique
+from holoradar.imaging import oblique, oblique_sum
 from holoradar.physics.propagation import clear_transfer_cache
 
 REPEAT = 7
@@ -91,7 +91,8 @@ _CASES = {
 
 
 def _spectrum_args(name: str):
-    """What ``_spectrum_on_plane`` receives in this case (the grid migrate_ground picks)."""
+    """What ``sum_to_plane`` receives in this case (the grid the ground frame picks):
+    ``(geometry, data, kk, grid, pitch, origin, work, gap)``."""
     if _CASES[name] is None:
         rng = np.random.default_rng(1)
         x = (np.arange(10) - 4.5) * 0.015
@@ -99,20 +100,21 @@ def _spectrum_args(name: str):
         d = rng.standard_normal((8, 10)) + 1j * rng.standard_normal((8, 10))
         pose = hr.Pose((0.01, -0.02, 0.05), tilt=np.radians(35), azimuth=np.radians(30))
         h = hr.Hologram(d, x, y, F0, pose=pose)
-        return (h, (40, 44), (0.01, 0.012), (-0.1, -0.1, 0.2), np.dtype(complex), 0.2)
+        return (h, d[None], h.k, (40, 44), (0.01, 0.012), (-0.1, -0.1, 0.2),
+                np.dtype(complex), 0.2)
     h, gx, gy = _case(*_CASES[name])
     seen = {}
-    real = oblique._spectrum_on_plane
+    real = oblique_sum.sum_to_plane
 
     def spy(*a):
-        seen["args"] = a[:6]
+        seen["args"] = a[:8]
         return real(*a)
 
-    oblique._spectrum_on_plane = spy
+    oblique.sum_to_plane = spy
     try:
-        oblique.migrate_ground(h, np.array([0.42]), SAND, x=gx, y=gy)
+        hr.migrate(h, np.array([0.42]), medium=SAND, frame="ground", x=gx, y=gy)
     finally:
-        oblique._spectrum_on_plane = real
+        oblique.sum_to_plane = real
     return seen["args"]
 
 
@@ -122,16 +124,18 @@ import numpy as np
 sys.path.insert(0, {here!r})
 warnings.simplefilter("ignore")
 import bench_oblique as b
-from holoradar.imaging import oblique
+import holoradar as hr
+from holoradar.imaging import oblique_sum
 case = b._CASES[{name!r}]
 if case is None:
     args = b._spectrum_args({name!r})
     t0 = time.perf_counter()
-    oblique._spectrum_on_plane(*args, route={route!r})
+    oblique_sum.sum_to_plane(*args, route={route!r})
 else:
     h, gx, gy = b._case(*case)
     t0 = time.perf_counter()
-    oblique.migrate_ground(h, np.array([0.42]), b.SAND, x=gx, y=gy, route={route!r})
+    hr.migrate(h, np.array([0.42]), medium=b.SAND, frame="ground", x=gx, y=gy,
+               algorithm="ground-" + {route!r})
 print(time.perf_counter() - t0)
 """
 
@@ -148,13 +152,13 @@ def spectrum_routes() -> dict:
     rows = []
     for name in _CASES:
         args = _spectrum_args(name)
-        H = {r: oblique._spectrum_on_plane(*args, route=r) for r in ROUTES}   # warm-up
+        H = {r: oblique_sum.sum_to_plane(*args, route=r) for r in ROUTES}   # warm-up
         err = float(np.linalg.norm(H["nufft"] - H["direct"]) / np.linalg.norm(H["direct"]))
         times = {r: [] for r in ROUTES}
         for _ in range(REPEAT):                     # interleaved
             for r in ROUTES:
                 t0 = time.perf_counter()
-                oblique._spectrum_on_plane(*args, route=r)
+                oblique_sum.sum_to_plane(*args, route=r)
                 times[r].append(time.perf_counter() - t0)
         warm = {r: float(np.median(times[r])) for r in ROUTES}
         cold = {r: [] for r in ROUTES}
@@ -162,17 +166,17 @@ def spectrum_routes() -> dict:
             for r in ROUTES:
                 cold[r].append(_cold(name, r))
         cold_m = {r: float(np.median(cold[r])) for r in ROUTES}
-        grid = args[1]
-        chosen = oblique.choose_route(grid, args[0].pose, args[0].data.shape[-2:])
+        grid = args[3]
+        chosen = oblique_sum.choose_route(grid, args[0].pose, args[0].data.shape[-2:])
         res[name] = {"grid": list(grid), "elements": list(args[0].data.shape[-2:]),
                      "auto_route": chosen,
-                     "dtype": str(args[4]), "rel_l2_nufft_vs_direct": err,
-                     "eps": oblique_nufft_eps(args[4]),
+                     "dtype": str(args[6]), "rel_l2_nufft_vs_direct": err,
+                     "eps": oblique_nufft_eps(args[6]),
                      **{f"{r}_warm_s": warm[r] for r in ROUTES},
                      **{f"{r}_cold_s": cold_m[r] for r in ROUTES},
                      "warm_ratio_nufft_over_direct": warm["nufft"] / warm["direct"],
                      "cold_ratio_nufft_over_direct": cold_m["nufft"] / cold_m["direct"]}
-        cold_what = "sum" if _CASES[name] is None else "migrate_ground"
+        cold_what = "sum" if _CASES[name] is None else "migrate"
         rows.append(f"| {name} | {grid[0]}x{grid[1]} | {warm['direct'] * 1e3:.2f} ms | "
                     f"{warm['nufft'] * 1e3:.2f} ms | {warm['nufft'] / warm['direct']:.2f}x | "
                     f"{cold_m['direct'] * 1e3:.0f} / {cold_m['nufft'] * 1e3:.0f} ms "
@@ -192,17 +196,10 @@ def oblique_nufft_eps(work: np.dtype) -> float:
 
 
 def _forced(route: str | None, fn):
-    """``fn`` with the spectrum's route forced (None: the default choice)."""
-    def run():
-        if route is None:
-            return fn()
-        real = oblique.choose_route
-        oblique.choose_route = lambda *a: route
-        try:
-            return fn()
-        finally:
-            oblique.choose_route = real
-    return run
+    """``fn`` (given the ``algorithm``) with the spectrum's route forced (None: the
+    default choice)."""
+    algorithm = "auto" if route is None else f"ground-{route}"
+    return lambda: fn(algorithm)
 
 
 def against_frontal() -> dict:
@@ -219,9 +216,11 @@ def against_frontal() -> dict:
     zs = np.linspace(0.35, 0.5, 64)
     res: dict[str, object] = {"case": f"{N}x{N} tilted 35 deg over sand onto 128x128"}
     cases = {
-        "plane": (lambda: hr.migrate(tilted, z1, medium=SAND, frame="ground", x=gx, y=gy),
+        "plane": (lambda a: hr.migrate(tilted, z1, medium=SAND, frame="ground", x=gx, y=gy,
+                                       algorithm=a),
                   lambda: hr.migrate(frontal, z1, medium=SAND, upsample=4)),
-        "volume": (lambda: hr.migrate(tilted, zs, medium=SAND, frame="ground", x=gx, y=gy),
+        "volume": (lambda a: hr.migrate(tilted, zs, medium=SAND, frame="ground", x=gx,
+                                        y=gy, algorithm=a),
                    lambda: hr.migrate(frontal, zs, medium=SAND, upsample=4)),
     }
     rows = []

@@ -14,6 +14,7 @@ how one is chosen.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any, Literal
 
@@ -174,8 +175,32 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     >>> round(img.peak()[2], 2)
     0.4
     """
-    settings = MigrationSettings(
+    options = (method, pad, upsample, compensate_loss, snr_db, fov, dtype, progress, combine,
+               equalize, algorithm, frame)
+    if x is None and y is None and _hashable(options):
+        settings = _settings(*options)   # the same options again: checked once
+    else:
+        settings = MigrationSettings(
+            method=method, pad=pad, upsample=upsample, compensate_loss=compensate_loss,
+            snr_db=snr_db, fov=fov, dtype=dtype, progress=progress, combine=combine,
+            equalize=equalize, algorithm=algorithm, frame=frame, x=x, y=y)
+    return image_of(hologram, z, medium, settings)
+
+
+@functools.lru_cache(maxsize=64, typed=True)
+def _settings(method: Any, pad: Any, upsample: Any, compensate_loss: Any, snr_db: Any,
+              fov: Any, dtype: Any, progress: Any, combine: Any, equalize: Any,
+              algorithm: Any, frame: Any) -> MigrationSettings:
+    """Validated settings, kept for the next call with the same options (they are
+    immutable; a survey or a viewer images frame after frame with the same ones)."""
+    return MigrationSettings(
         method=method, pad=pad, upsample=upsample, compensate_loss=compensate_loss,
         snr_db=snr_db, fov=fov, dtype=dtype, progress=progress, combine=combine,
-        equalize=equalize, algorithm=algorithm, frame=frame, x=x, y=y)
-    return image_of(hologram, z, medium, settings)
+        equalize=equalize, algorithm=algorithm, frame=frame)
+
+
+def _hashable(options: tuple) -> bool:
+    # Plain values only: numpy scalars of different types can hash alike yet validate
+    # apart (True == 1), so the cache takes exactly bool, int, float, str, None, types.
+    return all(type(v) in (bool, int, float, str, type(None), type) or isinstance(v, np.dtype)
+               for v in options)

@@ -62,9 +62,10 @@ def _preferences(plan: MigrationPlan) -> list[Backend]:
         return _ground(plan)
     if plan.settings.method == "fresnel":
         return [BACKENDS["fresnel"]]
-    if plan.geometry.is_wideband:
+    if plan.wideband:
         return [BACKENDS["columns"], BACKENDS["kspace"], BACKENDS["frequency"]]
-    step = [BACKENDS["kspace"]] if _too_big_to_cache(plan) else []
+    # (one plane: nothing to step to)
+    step = [BACKENDS["kspace"]] if plan.z.size > 1 and _too_big_to_cache(plan) else []
     return [*step, BACKENDS["frequency"]]
 
 

@@ -12,6 +12,9 @@ separate images.
 
 from __future__ import annotations
 
+import threading
+import weakref
+from collections import OrderedDict
 from typing import Any
 
 import numpy as np
@@ -19,7 +22,7 @@ import numpy as np
 from ...data.hologram import Hologram, Image
 from .choose import choose
 from .memory import check_fits
-from .plan import make_plan
+from .plan import make_plan, warn
 from .settings import MigrationSettings
 
 __all__ = ["Migration", "image_of"]
@@ -72,7 +75,8 @@ class Migration:
 
     def _frames(self, data: np.ndarray) -> tuple[tuple[int, ...], np.ndarray]:
         shape = self.plan.data_shape
-        data = np.asarray(data)
+        if type(data) is not np.ndarray:
+            data = np.asarray(data)
         if data.shape[data.ndim - len(shape):] != shape:
             raise ValueError(f"data must end in shape {shape} (this geometry's samples), "
                              f"got {data.shape}")
@@ -118,10 +122,63 @@ class Migration:
 
 def image_of(hologram: Hologram, z: Any, medium: Any, settings: MigrationSettings) -> Image:
     """``migrate(hologram, z, medium=medium, **settings)`` (see :func:`holoradar.migrate`):
-    refused before any work where the volume would not fit in memory."""
-    m = Migration(hologram, z, medium, settings)
+    refused before any work where the volume would not fit in memory.
+
+    The same hologram object migrated again onto the same planes with the same settings
+    (a viewer's redraw, a benchmark, a loop over methods) reuses its plan (a plan holds
+    no data; the hologram is immutable): what the call warns about is said again."""
+    m = _recent(hologram, z, medium, settings)
     g = m.plan.geometry
-    fast = m.backend.name in ("columns", "kspace", "stolt") or not g.is_wideband
-    check_fits(g, m.plan.z.size * (g.nf if m.plan.separate else 1), settings.upsample,
+    fast = m.backend.name in ("columns", "kspace", "stolt") or not m.plan.wideband
+    check_fits(g, m.plan.z.size * (m.plan.nf if m.plan.separate else 1), settings.upsample,
                settings.dtype, factor=1.5 if fast else 3.0)
-    return m.image(g.data)
+    img = m.image(hologram.data)
+    _keep(hologram, z, medium, settings, m)
+    return img
+
+
+_RECENT: OrderedDict[tuple, tuple[Any, Migration]] = OrderedDict()
+_RECENT_SIZE = 4
+_RECENT_MEMO_BYTES = 1 << 24   # a plan that keeps more (illumination phasors) is not kept
+_LOCK = threading.Lock()
+
+
+def _key(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -> tuple | None:
+    if type(z) is float:
+        zkey: Any = z
+    elif isinstance(z, np.ndarray | list | tuple):
+        zkey = np.asarray(z, dtype=float).tobytes() + bytes([np.ndim(z)])
+    else:
+        return None
+    try:
+        return (id(hologram), zkey, medium, settings) if hash(medium) is not None else None
+    except TypeError:
+        return None
+
+
+def _recent(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -> Migration:
+    key = _key(hologram, z, medium, settings)
+    with _LOCK:
+        hit = _RECENT.get(key) if key is not None else None
+        if hit is not None and hit[0]() is hologram:
+            _RECENT.move_to_end(key)
+            m = hit[1]
+        else:
+            m = None
+    if m is None:
+        return Migration(hologram, z, medium, settings)
+    warn(hologram, m.settings, m.plan.illumination)
+    return m
+
+
+def _keep(hologram: Any, z: Any, medium: Any, settings: MigrationSettings,
+          m: Migration) -> None:
+    key = _key(hologram, z, medium, settings)
+    kept = sum(getattr(v, "nbytes", 0) for v in m.plan.memo.values())
+    if key is None or kept > _RECENT_MEMO_BYTES:
+        return
+    with _LOCK:
+        _RECENT[key] = (weakref.ref(hologram), m)
+        _RECENT.move_to_end(key)
+        while len(_RECENT) > _RECENT_SIZE:
+            _RECENT.popitem(last=False)

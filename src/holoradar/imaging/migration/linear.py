@@ -97,6 +97,7 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
         raise ValueError("combine='incoherent' is not linear (the root sum of squares of "
                          "the frequencies' images): give combine='coherent' or 'none'")
     plan = make_plan(hologram, z, medium, s)
+    plan.snr_db  # noqa: B018  (estimated now, from the data given: the map is then fixed)
     return MigrationOperator(plan, choose(plan))
 
 

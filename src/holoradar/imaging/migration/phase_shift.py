@@ -90,7 +90,7 @@ class PhaseShift(Backend):
                 g.y[0] + np.arange(u * (ny - 1) + 1) * dy / u)
 
     def method(self, plan: MigrationPlan) -> str:
-        return "kspace" if plan.geometry.is_wideband else "angular"
+        return "kspace" if plan.wideband else "angular"
 
 
 class Columns(PhaseShift):

@@ -10,7 +10,9 @@ fit, an iterative solver's vectors).
 
 from __future__ import annotations
 
+import copy
 import warnings
+import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,8 +39,9 @@ class MigrationPlan:
     Attributes
     ----------
     geometry : Hologram
-        The hologram the plan was made for: its grid, frequencies, source, pose and
-        polarisation (its data are not used again).
+        The hologram the plan was made for, without its data (a zero-stride view of
+        their shape and dtype): its grid, frequencies, source, pose and polarisation.
+        A plan holds no data (an operator kept for a solver costs no memory for it).
     settings : MigrationSettings
     z : ndarray
         Ranges of the image planes, metres (``frame="ground"``: world ranges).
@@ -61,8 +64,16 @@ class MigrationPlan:
         transceiver: ``"none"``, its illumination is in the round trip).
     pad : bool or float
         The padding every frequency uses (``fov="full"`` on a band: one factor).
+    nf : int
+        Number of frequencies.
+    wideband : bool
+        The hologram has a frequency axis.
+    grid : (int, int)
+        ``(ny, nx)`` of the data.
     memo : dict
         What backends compute once per plan (grids, transfers' owners, phasors).
+    data : weakref.ref
+        The hologram whose data the SNR is estimated from, on first use.
     """
 
     geometry: Hologram
@@ -76,6 +87,10 @@ class MigrationPlan:
     compensates: bool
     illumination: str
     pad: bool | float
+    nf: int
+    wideband: bool
+    grid: tuple[int, int]
+    data: Any = field(default=None, repr=False)
     memo: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -89,34 +104,32 @@ class MigrationPlan:
             # The planes' ranges and the ground's as seen from the aperture's plane
             # (world ranges in the ground frame).
             ground = self.local if s.frame == "aperture" else self.medium
+            source = self.data() if self.data is not None else None
+            if s.snr_db is None and source is None:
+                raise ValueError("the plan's hologram is gone: its SNR (for the loss "
+                                 "compensation) can no longer be estimated; give snr_db")
             self.memo["snr_db"] = s.snr_db if s.snr_db is not None else data_snr(
-                self.geometry, None if ground.is_free_space else ground, self.z)
+                source, None if ground.is_free_space else ground, self.z)
         return self.memo["snr_db"]
-
-    @property
-    def nf(self) -> int:
-        """Number of frequencies."""
-        return self.geometry.nf
 
     @property
     def wavenumbers(self) -> np.ndarray:
         """Wavenumbers in air, rad/m (nf,)."""
-        return self.geometry.wavenumbers
-
-    @property
-    def grid(self) -> tuple[int, int]:
-        """``(ny, nx)`` of the data."""
-        return self.geometry.data.shape[-2:]
+        ks = self.memo.get("wavenumbers")
+        if ks is None:
+            ks = self.memo["wavenumbers"] = self.geometry.wavenumbers
+            ks.setflags(write=False)
+        return ks
 
     @property
     def data_shape(self) -> tuple[int, ...]:
         """One frame's data: ``(nf, ny, nx)`` for a band, ``(ny, nx)`` for one frequency."""
-        return ((self.nf,) if self.geometry.is_wideband else ()) + tuple(self.grid)
+        return ((self.nf,) if self.wideband else ()) + self.grid
 
     @property
     def separate(self) -> bool:
         """Each frequency keeps its own image (``combine`` "none" or "incoherent")."""
-        return self.settings.combine != "coherent" and self.geometry.is_wideband
+        return self.settings.combine != "coherent" and self.wideband
 
     @property
     def monostatic(self) -> bool:
@@ -166,9 +179,25 @@ def make_plan(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -
     weights = _weights(hologram, s.equalize)
     illumination = _illumination(hologram, s)
     _warn(hologram, s, illumination)
-    return MigrationPlan(hologram, s, zs, np.ndim(z) == 0, world, local, work, weights,
-                         s.compensate_loss and not world.is_lossless, illumination,
-                         _band_pad(hologram, zs, s))
+    wide = hologram.is_wideband
+    return MigrationPlan(without_data(hologram), s, zs, np.ndim(z) == 0, world, local, work,
+                         weights, s.compensate_loss and not world.is_lossless, illumination,
+                         _band_pad(hologram, zs, s), hologram.nf if wide else 1, wide,
+                         tuple(hologram.data.shape[-2:]), weakref.ref(hologram))
+
+
+def without_data(hologram: Hologram) -> Hologram:
+    """The hologram's geometry: a copy whose ``data`` is a read-only zero-stride view of
+    the data's shape and dtype (no memory)."""
+    g = copy.copy(hologram)
+    object.__setattr__(g, "data", np.broadcast_to(np.zeros((), hologram.data.dtype),
+                                                  hologram.data.shape))
+    return g
+
+
+def warn(hologram: Hologram, s: MigrationSettings, illumination: str) -> None:
+    """What a migration of ``hologram`` warns about (said again on every call)."""
+    _warn(hologram, s, illumination)
 
 
 def _local_medium(medium: Medium, pose: Any) -> Medium:
@@ -183,11 +212,15 @@ def _local_medium(medium: Medium, pose: Any) -> Medium:
                   medium.polarization)
 
 
+_ONE = np.ones(1)
+_ONE.setflags(write=False)
+
+
 def _weights(hologram: Hologram, equalize: Any) -> np.ndarray:
     """The frequencies' weights: unit RMS each (True), 1 (False), or those given."""
-    nf = hologram.nf
     if not hologram.is_wideband:
-        return np.ones(1)
+        return _ONE
+    nf = hologram.nf
     if isinstance(equalize, bool):
         if not equalize:
             return np.ones(nf)
@@ -235,8 +268,8 @@ def _warn(hologram: Hologram, s: MigrationSettings, illumination: str) -> None:
                       "source for the true one", IlluminationWarning,
                       stacklevel=outside_stacklevel())
     # A transceiver's round trip doubles the transverse wavenumbers: lambda/4 sampling.
-    warn_if_aliased(max(hologram.pitch), C0 / hologram.frequencies[-1], "hologram",
-                    round_trip=hologram.monostatic)
+    top = float(hologram.frequency[-1]) if hologram.is_wideband else hologram.frequency
+    warn_if_aliased(max(hologram.pitch), C0 / top, "hologram", round_trip=hologram.monostatic)
 
 
 def _band_pad(hologram: Hologram, zs: np.ndarray, s: MigrationSettings) -> bool | float:

@@ -42,6 +42,7 @@ __all__ = ["FresnelPlanes", "PlaneByPlane"]
 _CHUNK = 8  # planes per batched inverse FFT
 _THREADED_MULTIPLY = 1 << 19  # products (planes x components) worth sharing among threads
 _SUM_BYTES = 1 << 28  # spectra of a band held at once to sum them before the inverse FFT
+_KEEP_BYTES = 1 << 27  # a plan's effective transfers kept with it up to this size
 
 
 class PlaneByPlane(Backend):
@@ -59,14 +60,19 @@ class PlaneByPlane(Backend):
 
     # ------------------------------------------------------------------ geometry
     def propagator(self, plan: MigrationPlan, i: int) -> _PlaneOperator:
-        """Frequency ``i``'s propagator onto the plan's planes (transfers cached)."""
-        g = plan.geometry
-        dx, dy = g.pitch
-        snr = plan.snr_db
-        return self.propagator_class(
-            plan.grid, dx, dy, float(plan.wavenumbers[i]), plan.z, plan.local, plan.pad,
-            plan.work, compensate_loss=snr is not None, snr_db=40.0 if snr is None else snr,
-            monostatic=g.monostatic)
+        """Frequency ``i``'s propagator onto the plan's planes (made once per plan; its
+        transfer functions cached)."""
+        key = ("propagator", self.name, i)
+        op = plan.memo.get(key)
+        if op is None:
+            g = plan.geometry
+            dx, dy = g.pitch
+            snr = plan.snr_db
+            op = plan.memo[key] = self.propagator_class(
+                plan.grid, dx, dy, float(plan.wavenumbers[i]), plan.z, plan.local, plan.pad,
+                plan.work, compensate_loss=snr is not None,
+                snr_db=40.0 if snr is None else snr, monostatic=g.monostatic)
+        return op
 
     def _frame(self, plan: MigrationPlan, grid: tuple[int, int]) -> tuple[int, int, int, int]:
         """``(oy, ox, sy, sx)``: the output's size and the shift of the aperture in it."""
@@ -78,12 +84,19 @@ class PlaneByPlane(Backend):
         return u * (ny - 1) + 1, u * (nx - 1) + 1, 0, 0
 
     def axes(self, plan: MigrationPlan) -> tuple[np.ndarray, np.ndarray]:
-        g = plan.geometry
-        dx, dy = g.pitch
-        u = plan.settings.upsample
-        grid = self.propagator(plan, plan.nf - 1).fft_shape
-        oy, ox, sy, sx = self._frame(plan, grid)
-        return (g.x[0] + (np.arange(ox) - sx) * dx / u, g.y[0] + (np.arange(oy) - sy) * dy / u)
+        key = ("axes", self.name)
+        if key not in plan.memo:
+            g = plan.geometry
+            dx, dy = g.pitch
+            u = plan.settings.upsample
+            grid = self.propagator(plan, plan.nf - 1).fft_shape
+            oy, ox, sy, sx = self._frame(plan, grid)
+            x = g.x[0] + (np.arange(ox) - sx) * dx / u
+            y = g.y[0] + (np.arange(oy) - sy) * dy / u
+            x.setflags(write=False)
+            y.setflags(write=False)
+            plan.memo[key] = (x, y)
+        return plan.memo[key]
 
     # ------------------------------------------------------------------- adjoint
     def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
@@ -121,26 +134,52 @@ class PlaneByPlane(Backend):
                         data: np.ndarray, bar: _Progress) -> np.ndarray:
         """The band's spectra summed per FFT grid before one inverse FFT per plane."""
         B, nz = data.shape[0], plan.z.size
-        factors = [illumination.uniform(plan, i) for i in range(len(ops))]
-        H = [op.spectrum(data[:, i]) * plan.work.type(plan.weights[i])
-             for i, op in enumerate(ops)]
+        H = [op.spectrum(data[:, i]) for i, op in enumerate(ops)]
         out: np.ndarray | None = None
         for grid, members in _groups(ops).items():
-            oy, ox, sy, sx = self._frame(plan, grid)
-            if out is None:
-                out = np.zeros((B, nz, oy, ox), dtype=plan.work)
+            frame = self._frame(plan, grid)
+            U = {i: self.effective(plan, ops, i) for i in members}
             for c0 in range(0, nz, _CHUNK):
                 sel = range(c0, min(nz, c0 + _CHUNK))
-                S = np.zeros((B, len(sel), *grid), dtype=plan.work)
-                for i in members:
-                    Ucs = ops[i].adjoint_transfers
-                    for j, iz in enumerate(sel):
-                        U = Ucs[iz] if factors[i] is None else Ucs[iz] * factors[i][iz]
-                        S[:, j] += H[i] * U
-                out[:, c0:c0 + len(sel)] += self._inverse(plan, S, grid, (oy, ox, sy, sx),
-                                                          ops[0].workers)
+                # One plane of one frequency: multiplied in its own spectrum (ours).
+                S = H[members[0]][:, None] if nz == 1 and len(members) == 1 else \
+                    np.empty((B, len(sel), *grid), dtype=plan.work)
+                for j, iz in enumerate(sel):
+                    np.multiply(H[members[0]], U[members[0]][iz], out=S[:, j])
+                    for i in members[1:]:
+                        S[:, j] += H[i] * U[i][iz]
+                planes = self._inverse(plan, S, grid, frame, ops[0].workers)
+                if out is None and len(sel) == nz:
+                    out = planes   # one chunk of one grid: the image itself
+                else:
+                    if out is None:
+                        out = np.zeros((B, nz, frame[0], frame[1]), dtype=plan.work)
+                    out[:, c0:c0 + len(sel)] += planes
                 bar.update(len(sel) * len(members))
         assert out is not None
+        return out
+
+    def effective(self, plan: MigrationPlan, ops: list[_PlaneOperator], i: int,
+                  forward: bool = False) -> list[np.ndarray]:
+        """Frequency ``i``'s adjoint transfers with its weight and the uniform
+        illumination's ``conj(psi)`` folded in (``forward``: their conjugates, the
+        forward map's), one per plane: kept with the plan while they are small enough
+        (the next call, a solver's next iterate, reuses them)."""
+        key = ("effective", self.name, i, forward)
+        if key in plan.memo:
+            return plan.memo[key]
+        Ucs = ops[i].adjoint_transfers
+        w = float(plan.weights[i]) if plan.nf > 1 else 1.0
+        f = illumination.uniform(plan, i)
+        if w == 1.0 and f is None and not forward:
+            return Ucs
+        scale = np.full(len(Ucs), w, dtype=complex) * (1 if f is None else f)
+        out = [np.conj(U * plan.work.type(c)) if forward else U * plan.work.type(c)
+               for U, c in zip(Ucs, scale, strict=True)]
+        for U in out:
+            U.setflags(write=False)
+        if sum(U.nbytes for U in out) <= _KEEP_BYTES:
+            plan.memo[key] = out
         return out
 
     def _inverse(self, plan: MigrationPlan, S: np.ndarray, grid: tuple[int, int],
@@ -206,21 +245,27 @@ class PlaneByPlane(Backend):
         x, y = self.axes(plan)
         for grid, members in _groups(ops).items():
             frame = self._frame(plan, grid)
-            acc = {i: np.zeros((B, *grid), dtype=plan.work) for i in members}
-            factors = {i: illumination.uniform(plan, i) if uniform else None
-                       for i in members}
+            acc: dict[int, np.ndarray] = {}
             for i in (members if not uniform else [None]):
+                # A uniform illumination is folded into the (kept) forward transfers; a
+                # per-pixel one multiplies each frequency's reflectivity.
                 r = image if i is None else self._illuminated(plan, image, i, x, y)
                 for j in range(plan.z.size):
                     R = self._spectrum_of(plan, r[:, j], grid, frame, ops[members[0]].workers)
-                    for m in (members if i is None else [i]):
-                        U = np.conj(ops[m].adjoint_transfers[j])
-                        if factors[m] is not None:
-                            U = U * np.conj(factors[m][j])
-                        acc[m] += R * U
+                    these = members if i is None else [i]
+                    for m in these:
+                        U = self.effective(plan, ops, m, forward=True)[j] if uniform else \
+                            ops[m].transfers[j] if plan.snr_db is None else \
+                            np.conj(ops[m].adjoint_transfers[j])
+                        if m in acc:
+                            acc[m] += R * U
+                        elif m == these[-1]:   # R's last use: multiplied in place
+                            acc[m] = np.multiply(R, U, out=R)
+                        else:
+                            acc[m] = R * U
             for i in members:
-                w = plan.weights[i] if plan.nf > 1 else 1.0
                 back = ifft2_cropped(acc[i], (ny, nx), ops[i].workers, overwrite=True)
+                w = plan.weights[i] if plan.nf > 1 and not uniform else 1.0
                 out[:, i] = back * plan.work.type(w) if w != 1.0 else back
         return out
 
@@ -305,10 +350,10 @@ class _Progress:
     def __init__(self, plan: MigrationPlan, nf: int) -> None:
         s = plan.settings
         total = plan.z.size * nf
-        show = s.progress if s.progress is not None else \
-            total * math.prod(plan.grid) * s.upsample ** 2 > 2e8
         self.bar: Any = None
-        if show:
+        if s.progress is False:
+            return
+        if s.progress or total * plan.grid[0] * plan.grid[1] * s.upsample ** 2 > 2e8:
             from tqdm.auto import tqdm  # here, not at import: holoradar._lazy
 
             # delay: a bar only for work that lasts (progress=True shows it after 1 s)
