@@ -21,8 +21,8 @@ Part 2, this tree only: ``matvec`` + ``rmatvec`` of ``hr.migration_operator`` on
 512 x 512 plane (``pad=False``, complex64) over one in-place ``fft2`` + ``ifft2`` pair
 (each of the two maps needs one such pair: 2.0 is the floor of the two together).
 
-Run: ``.venv/bin/python benchmarks/bench_operator.py [case ...] [--rounds N]``; writes
-``benchmarks/results_operator.json`` and prints a Markdown table.
+Run: ``.venv/bin/python benchmarks/bench_operator.py [case ...] [--rounds N]``; merges
+the cases run into ``benchmarks/results_operator.json`` and prints a Markdown table.
 """
 
 from __future__ import annotations
@@ -208,8 +208,10 @@ if __name__ == "__main__":
     chosen = tuple(a for a in sys.argv[1:] if a in CASES) or CASES
     results = main(n, chosen)
     out = Path(__file__).with_name("results_operator.json")
+    merged = json.loads(out.read_text()) if out.exists() else {}
+    merged.update(results)   # the cases run replace theirs
     tmp = out.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(results, indent=2) + "\n")
+    tmp.write_text(json.dumps(merged, indent=2) + "\n")
     tmp.replace(out)
     print("\n| case | floor ms | before / floor | after / floor | after / before |\n"
           "|---|---|---|---|---|")

@@ -10,7 +10,7 @@ numpy:
     * planes above the deepest region: ``Medium.vertical_transfer(k, kappa2, z, 0)``
       (the whole layered recursion, per plane);
     * planes in the deepest region, ``algorithm="frequency"``: the "deepest-region
-      shortcut" of ``propagation._make_angular_transfer``, the transfer from the
+      shortcut" of ``propagation.make_angular_transfer``, the transfer from the
       top of the region times ``exp(i kz_N (z - top))``;
     * planes in the deepest region, ``algorithm="kspace"``: Gazdag's phase step
       (``imaging/kspace.py``), one transfer to the first plane and a factor

@@ -114,15 +114,15 @@ def test_cached_transfer_equals_the_layered_recursion(z, monostatic):
     recursion evaluated on the whole grid (the band limit included), exactly
     but for rounding: 1e-12."""
     from holoradar.physics.propagation import (
-        _make_angular_transfer,
         lateral_travel,
+        make_angular_transfer,
         spectral_axes,
         two_way_transfer,
     )
 
     medium = hr.Medium((0.1, 0.16, 0.3), (1, 4 + 0.3j, 9 + 0.5j, 6 + 0.2j))
     shape, dx, dy, k = (48, 64), 0.004, 0.005, 207.0
-    U = _make_angular_transfer(shape, dx, dy, k, z, medium, True, np.dtype(complex), False,
+    U = make_angular_transfer(shape, dx, dy, k, z, medium, True, np.dtype(complex), False,
                                None, monostatic)
     p, q = spectral_axes(shape, dx, dy)
     kappa2 = q[:, None] ** 2 + p[None, :] ** 2

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_axis
-from ..data.hologram import Hologram, _frequency_axis
+from ..data.hologram import Hologram, frequency_axis
 from ..io.netcdf import source_to_json
 from ._format import read_file, write_file
 from .iq import correct_iq
@@ -135,7 +135,7 @@ class Calibration:
         ya.setflags(write=False)
         ny, nx = ya.size, xa.size
         nf = int(np.size(frequency))
-        f = _frequency_axis(frequency, (nf, ny, nx))
+        f = frequency_axis(frequency, (nf, ny, nx))
         grid, per_f = (nf, ny, nx), (nf,)
         put = object.__setattr__
         put(self, "device", check_device(device))

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_axis
-from ..data.hologram import _frequency_axis
+from ..data.hologram import frequency_axis
 from ..data.pose import IDENTITY, Pose
 
 __all__ = ["RawFrames"]
@@ -90,7 +90,7 @@ class RawFrames:
             raise ValueError(f"i and q must have one shape, got {ia.shape} and {qa.shape}")
         xa = as_axis(x, "x", length=ia.shape[-1])
         ya = as_axis(y, "y", length=ia.shape[-2])
-        f = _frequency_axis(frequency, ia.shape)
+        f = frequency_axis(frequency, ia.shape)
         if source is not None and not (hasattr(source, "field") and hasattr(source, "reflected")):
             raise ValueError("source must be a PlaneWave, PointSource, GaussianBeam or None, got "
                              f"{type(source).__name__}")

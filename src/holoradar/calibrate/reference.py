@@ -30,7 +30,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ..data.hologram import C0, _frequency_axis
+from ..data.hologram import C0, frequency_axis
 from ..model.scene import Aperture, Scene
 from ..model.simulate import simulate
 from ..model.targets import PlanarTarget
@@ -106,9 +106,9 @@ def reference_field(kind: Literal["plate", "empty"], x: Any, y: Any, frequency: 
     aperture = Aperture(x, y)
     shape = (aperture.y.size, aperture.x.size)
     if np.ndim(frequency) == 0:
-        freqs, wide = np.atleast_1d(_frequency_axis(frequency, shape)), False
+        freqs, wide = np.atleast_1d(frequency_axis(frequency, shape)), False
     else:
-        freqs, wide = np.asarray(_frequency_axis(frequency, (np.size(frequency), *shape))), True
+        freqs, wide = np.asarray(frequency_axis(frequency, (np.size(frequency), *shape))), True
     pts = aperture.points
     free = Medium.free_space()
     if kind == "empty":

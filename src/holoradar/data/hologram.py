@@ -96,7 +96,7 @@ class Hologram:
         arr = as_finite_complex(data, "data", min_ndim=2)
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
-        f = _frequency_axis(frequency, arr.shape)
+        f = frequency_axis(frequency, arr.shape)
         if source is not None and not (hasattr(source, "field") and hasattr(source, "reflected")):
             raise ValueError("source must be a PlaneWave, PointSource, GaussianBeam or None, got "
                              f"{type(source).__name__}")
@@ -250,7 +250,7 @@ def has_polarization(source: Any) -> bool:
                                                                           "field_vector")
 
 
-def _frequency_axis(frequency: Any, shape: tuple[int, ...]) -> float | np.ndarray:
+def frequency_axis(frequency: Any, shape: tuple[int, ...]) -> float | np.ndarray:
     """A frequency in Hz, or a strictly increasing axis matching ``shape[-3]``."""
     if np.ndim(frequency) == 0:
         return check_frequency(frequency)

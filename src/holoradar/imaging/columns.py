@@ -38,7 +38,7 @@ from .. import _threads
 from .._lazy import lazy_module
 from .._threads import fft_workers, pool
 from ..physics.medium import Medium
-from ..physics.propagation import _CACHE
+from ..physics.propagation import TRANSFER_CACHE
 from ..physics.spectra import interpolate
 from . import kspace
 
@@ -243,7 +243,7 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
     key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, direct,
            work.str, tuple(weights != 0))
-    plan = _CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
+    plan = TRANSFER_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
     run = _kernel()

@@ -35,7 +35,7 @@ from .._lazy import lazy_module
 from .._threads import fft_workers
 from ..physics.medium import Medium
 from ..physics.propagation import (
-    _CACHE,
+    TRANSFER_CACHE,
     lateral_travel,
     padded_shape,
     spectral_quadrant,
@@ -75,7 +75,7 @@ def adjoint_kspace(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in ks),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident,
            work.str, tuple(weights != 0))
-    plan = _CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
+    plan = TRANSFER_CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
     Hc = plan.gather(data, weights, work, workers)
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1

@@ -28,7 +28,7 @@ import numpy as np
 from ..data.hologram import Hologram
 from ..model.targets import cylinder_polarizabilities
 from ..physics.dyadic import dyadic_times
-from ..physics.green import _legendre
+from ..physics.green import legendre
 from ..physics.medium import Medium
 from .point_response import PointResponse
 
@@ -83,7 +83,7 @@ class LineResponse(PointResponse):
         x, y, phi, length = (float(v) for v in xy)
         length = max(length, 1e-4)
         m = int(np.ceil(length * 2 * float(self.ks.max()) / np.pi * 1.3)) + 6
-        s, w = _legendre(-(-m // 8) * 8)
+        s, w = legendre(-(-m // 8) * 8)
         t = np.array([np.cos(phi), np.sin(phi)])
         pos = np.array([x, y]) + 0.5 * length * s[:, None] * t
         return pos, 0.5 * length * np.asarray(w), np.array([t[0], t[1], 0.0])

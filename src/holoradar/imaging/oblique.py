@@ -44,10 +44,10 @@ from .._validate import as_axis, uniform_step
 from ..data.hologram import Hologram
 from ..physics.medium import Medium
 from ..physics.propagation import (
-    _CACHE,
-    _basis,
-    _make_angular_transfer,
+    TRANSFER_CACHE,
+    basis_of,
     lateral_travel,
+    make_angular_transfer,
     padded_shape,
 )
 from ..physics.spectra import fft2_padded, fold, interpolate
@@ -257,14 +257,14 @@ def _ground_transfer(grid: tuple[int, int], pitch: tuple[float, float], k: float
            compensate_loss)
 
     def make() -> np.ndarray:
-        U = _make_angular_transfer(grid, *pitch, k, z, medium, False, work, True,
+        U = make_angular_transfer(grid, *pitch, k, z, medium, False, work, True,
                                    compensate_loss, mono)
         out = U * _make_band_limit(grid, pitch, k, medium, z, rise, mono, reach)
         out = out.astype(work, copy=False)
         out.setflags(write=False)
         return out
 
-    return _CACHE.get(key, make)
+    return TRANSFER_CACHE.get(key, make)
 
 
 def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float,
@@ -274,7 +274,7 @@ def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float
     dx, dy = pitch
     # On one quadrant of the spectrum (|p|, |q|), from the cached basis: below the
     # last interface the travel grows linearly, t = t_top + (z - top) / Re(kz).
-    b = _basis(grid, dx, dy, k, medium, mono)
+    b = basis_of(grid, dx, dy, k, medium, mono)
     if medium.region_of(z) == medium.n_regions - 1:
         with np.errstate(invalid="ignore"):
             t = b.t_top + (b.rate * (z - b.top) if z > b.top else 0.0)

@@ -35,7 +35,7 @@ import numpy as np
 from .._lazy import lazy_module
 from .._validate import uniform_step
 from ..data.hologram import Hologram
-from ..physics.propagation import _CACHE, spectral_axes
+from ..physics.propagation import TRANSFER_CACHE, spectral_axes
 
 finufft = lazy_module("finufft")  # imported on first use: see holoradar._lazy
 
@@ -109,8 +109,8 @@ def _basis_of(geometry: Hologram, kk: float, grid: tuple[int, int], pitch: tuple
               origin: tuple[float, float, float], work: np.dtype, reach: float) -> _NufftRemap:
     key = ("ground-nufft", grid, pitch, origin, kk, geometry.pose, geometry.x.tobytes(),
            geometry.y.tobytes(), work.str, round(reach, 6))
-    return _CACHE.get(key, lambda: _NufftRemap.build(grid, pitch, origin, kk, geometry.pose,
-                                                     geometry.x, geometry.y, work, reach))
+    return TRANSFER_CACHE.get(key, lambda: _NufftRemap.build(
+        grid, pitch, origin, kk, geometry.pose, geometry.x, geometry.y, work, reach))
 
 
 class _NufftRemap:

@@ -23,7 +23,7 @@ import numpy as np
 
 from .._validate import uniform_step
 from ..data.hologram import Hologram
-from ..physics.propagation import _CACHE, spectral_axes
+from ..physics.propagation import TRANSFER_CACHE, spectral_axes
 from .oblique_nufft import elements_nufft, spectrum_nufft
 
 #: Components evanescent in the air damped below this over the air gap are left out.
@@ -128,7 +128,7 @@ def _remap(geometry: Hologram, kk: float, grid: tuple[int, int], pitch: tuple[fl
            origin: tuple[float, float, float], work: np.dtype, reach: float) -> _Remap:
     key = ("ground-basis", grid, pitch, origin, kk, geometry.pose, geometry.x.tobytes(),
            geometry.y.tobytes(), work.str, round(reach, 6))
-    return _CACHE.get(key, lambda: _Remap.build(grid, pitch, origin, kk, geometry.pose,
+    return TRANSFER_CACHE.get(key, lambda: _Remap.build(grid, pitch, origin, kk, geometry.pose,
                                                 geometry.x, geometry.y, work, reach))
 
 

@@ -26,7 +26,7 @@ from ..physics.medium import Medium
 from ..physics.propagation import DEFAULT_SNR_DB
 from ..physics.sources import PointSource
 from ..theory import lateral_resolution
-from .glare import FitWarning, _direct_wave, suppress_surface
+from .glare import FitWarning, direct_wave, suppress_surface
 from .migration.image import Migration
 from .migration.settings import MigrationSettings
 from .synthesis import _check_views
@@ -110,7 +110,7 @@ class StreamImager:
                 raise ValueError("suppress=True needs each view's source to be a PointSource")
             _, rep = suppress_surface(v, medium, v.source, "gaussian")
             theta.append([rep.parameters["x"], rep.parameters["y"], rep.parameters["b"]])
-            D.append(_direct_wave(v.source, self.k, self.pts))
+            D.append(direct_wave(v.source, self.k, self.pts))
         self.D = np.stack(D)                                   # (K, N)
         self.theta = np.array(theta, float)                    # (K, 3): xc, yc, b
         self.zm = np.array([2 * medium.z_interfaces[0] - v.source.position[2] for v in views])

@@ -39,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import as_polarization, as_real, check_frequency
-from ..data.hologram import C0, Hologram, _frequency_axis, has_polarization
+from ..data.hologram import C0, Hologram, frequency_axis, has_polarization
 from ..physics.dyadic import (
     RadialDyadic,
     free_space_dyadic,
@@ -125,7 +125,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
     if np.ndim(frequency) == 0:
         freqs, wide = np.array([check_frequency(frequency)]), False
     else:
-        freqs, wide = _frequency_axis(frequency, (np.size(frequency), 1, 1)), True
+        freqs, wide = frequency_axis(frequency, (np.size(frequency), 1, 1)), True
     if isinstance(aperture, Aperture):
         pts = aperture.points
     else:

@@ -60,7 +60,7 @@ def free_space_green(k: complex, src: np.ndarray, pts: np.ndarray) -> np.ndarray
 
 
 @functools.lru_cache(maxsize=64)
-def _legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+def legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     # Gauss-Legendre rules are computed once per n: numpy's eigenvalue problem for small
     # n, scipy's asymptotic expansions (nodes exact to 1e-16, weights to ~1e-11, O(n))
     # beyond 192, where the eigenvalue problem already costs 3x more (0.03 s at n = 512,
@@ -90,7 +90,7 @@ def _rule_size(n: int) -> int:
 
 
 def _gauss(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = _legendre(_rule_size(n))
+    x, w = legendre(_rule_size(n))
     return 0.5 * (b - a) * x + 0.5 * (b + a), 0.5 * (b - a) * w
 
 

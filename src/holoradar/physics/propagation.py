@@ -39,13 +39,16 @@ sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 __all__ = [
     "DEFAULT_SNR_DB",
+    "TRANSFER_CACHE",
     "AngularSpectrum",
     "Fresnel",
     "absorption_gain",
+    "basis_of",
     "clear_transfer_cache",
     "ifft2_cropped",
     "lateral_travel",
     "loss_exponent",
+    "make_angular_transfer",
     "padded_shape",
     "spectral_axes",
     "transfer_cache_bytes",
@@ -250,17 +253,19 @@ class _TransferCache:
             self._bytes = 0
 
 
-_CACHE = _TransferCache(256 * 2**20)
+#: Transfer functions, spectral bases and the plans built from them, shared by every
+#: propagator and migration backend (least recently used out beyond 256 MiB).
+TRANSFER_CACHE = _TransferCache(256 * 2**20)
 
 
 def clear_transfer_cache() -> None:
     """Free the cached transfer functions (at most 256 MiB are kept)."""
-    _CACHE.clear()
+    TRANSFER_CACHE.clear()
 
 
 def transfer_cache_bytes() -> int:
     """The most bytes of transfer functions kept between calls (256 MiB)."""
-    return _CACHE.max_bytes
+    return TRANSFER_CACHE.max_bytes
 
 
 def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
@@ -269,7 +274,7 @@ def _angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z:
                       monostatic: bool = False) -> np.ndarray:
     key = (shape, dx, dy, k, z, medium, band_limit, np.dtype(dtype).str, conjugate,
            compensate_loss, monostatic)
-    return _CACHE.get(key, lambda: _make_angular_transfer(*key[:7], np.dtype(dtype),
+    return TRANSFER_CACHE.get(key, lambda: make_angular_transfer(*key[:7], np.dtype(dtype),
                                                           conjugate, compensate_loss,
                                                           monostatic))
 
@@ -351,17 +356,22 @@ class _Basis:
         return basis
 
 
-def _basis(shape: tuple[int, int], dx: float, dy: float, k: float, medium: Medium,
+def basis_of(shape: tuple[int, int], dx: float, dy: float, k: float, medium: Medium,
            monostatic: bool) -> _Basis:
+    """What every plane of one FFT grid, wavenumber and medium shares (cached)."""
     key = ("basis", shape, dx, dy, k, medium, monostatic)
-    return _CACHE.get(key, lambda: _Basis.build(shape, dx, dy, k, medium, monostatic))
+    return TRANSFER_CACHE.get(key, lambda: _Basis.build(shape, dx, dy, k, medium, monostatic))
 
 
-def _make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
+def make_angular_transfer(shape: tuple[int, int], dx: float, dy: float, k: float, z: float,
                            medium: Medium, band_limit: bool, dtype: np.dtype,
                            conjugate: bool, compensate_loss: float | None,
                            monostatic: bool = False) -> np.ndarray:
-    b = _basis(shape, dx, dy, k, medium, monostatic)
+    """The transfer from range ``z`` to the aperture on an FFT grid ``shape`` (FFT
+    order, ``dtype``, read-only): band limited (``band_limit``), conjugated with the
+    loss compensation's gain (``conjugate``, ``compensate_loss`` the SNR in dB or None),
+    a transceiver's round trip (``monostatic``). Not cached: see :class:`AngularSpectrum`."""
+    b = basis_of(shape, dx, dy, k, medium, monostatic)
     deepest = medium.region_of(z) == medium.n_regions - 1
     if deepest:
         U = np.exp(1j * (z - b.top) * b.kz)

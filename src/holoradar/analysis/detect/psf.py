@@ -178,7 +178,7 @@ def pad_variants(shape: tuple[int, int], pitch: tuple[float, float], wavelength:
     return out or [True]
 
 
-_CACHE: dict[tuple, _Aperture] = {}
+TRANSFER_CACHE: dict[tuple, _Aperture] = {}
 _CACHE_SIZE = 16
 
 
@@ -189,11 +189,11 @@ def _aperture(vol: Volume, u: int, frequency: float, medium: Medium | None,
     key = (vol.data.shape[1:], round(float(vol.x[0]), 9), round(float(vol.y[0]), 9),
            round(vol.dx, 12), round(vol.dy, 12), float(frequency), round(float(vol.z[0]), 9),
            medium, u, pad)
-    ap = _CACHE.get(key)
+    ap = TRANSFER_CACHE.get(key)
     if ap is None:
-        if len(_CACHE) >= _CACHE_SIZE:
-            _CACHE.pop(next(iter(_CACHE)))
-        ap = _CACHE[key] = _Aperture(vol, u, frequency, medium, pr_medium, pad)
+        if len(TRANSFER_CACHE) >= _CACHE_SIZE:
+            TRANSFER_CACHE.pop(next(iter(TRANSFER_CACHE)))
+        ap = TRANSFER_CACHE[key] = _Aperture(vol, u, frequency, medium, pr_medium, pad)
     return ap
 
 

@@ -40,8 +40,8 @@ an image's brightest point is the glare), ``_common`` (the direct wave, linear
 fits).
 """
 
-# _direct_wave: imported by holoradar.imaging.stream (re-exported, private)
-from ._common import _direct_wave as _direct_wave
+# direct_wave: imported by holoradar.imaging.stream (re-exported, private)
+from ._common import direct_wave as direct_wave
 from .dominance import GlareShare, GlareWarning, glare_share
 from .permittivity import estimate_permittivity
 from .suppress import FitWarning, SuppressionReport, suppress_surface

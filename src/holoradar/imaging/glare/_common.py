@@ -1,6 +1,6 @@
 """Pieces the glare fits share: the radiator's direct wave and linear least squares.
 
-``_direct_wave`` is also imported by :mod:`holoradar.imaging.stream`.
+``direct_wave`` is also imported by :mod:`holoradar.imaging.stream`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ def _recorded(hologram: Hologram, src: object) -> np.ndarray | None:
     return None
 
 
-def _direct_wave(src: Radiator, k: float, pts: np.ndarray,
+def direct_wave(src: Radiator, k: float, pts: np.ndarray,
                  pol: np.ndarray | None = None) -> np.ndarray:
     """The radiator's own wave at air points, for unit amplitude: ``exp(ikR)/R`` times its
     pattern along the straight ray, or the incoming Gaussian beam (the shape the

@@ -8,7 +8,7 @@ from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _direct_wave, _recorded, _require_direct_wave
+from ._common import _recorded, _require_direct_wave, direct_wave
 from .suppress import suppress_surface
 
 __all__ = ["estimate_permittivity"]
@@ -46,7 +46,7 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     """
     src = source if source is not None else getattr(hologram, "source", None)
     if direct and isinstance(src, PointSource | GaussianBeam | Dipole):
-        _require_direct_wave(_direct_wave(src, hologram.k, hologram.points,
+        _require_direct_wave(direct_wave(src, hologram.k, hologram.points,
                                           _recorded(hologram, src)), hologram.data)
     _, rep = suppress_surface(hologram, medium, source, "image_source", direct=direct)
     return rep.eps, rep.eps_std
