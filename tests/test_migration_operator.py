@@ -54,6 +54,8 @@ def _holo(kind: str) -> hr.Hologram:
         return hr.Hologram(data(5, 10, 12), x * 0.5, y * 0.5, BAND, monostatic=True)
     if kind == "horn-band":
         return hr.Hologram(data(5, 10, 12), x, y, BAND, source=hr.PointSource((0.0, -0.2, -0.05)))
+    if kind == "pw-band":       # a receiver array's band lit by a normal plane wave
+        return hr.Hologram(data(5, 10, 12), x, y, BAND, source=hr.PlaneWave())
     if kind == "raised":        # a level array 5 cm above the reference plane z = 0
         return hr.Hologram(data(10, 12), x, y, F0, source=hr.PlaneWave(),
                            pose=hr.Pose((0.0, 0.0, 0.05)))
@@ -91,8 +93,16 @@ CASES = [
     ("transceiver", LOSSY, "frequency", {"combine": "none", "compensate_loss": True}),
     ("horn-band", LOSSY, "frequency", {}),
     ("horn-band", SAND, "frequency", {"combine": "none", "illumination": "phase"}),
+    ("horn", LOSSY, "frequency", {"scatterer": "point", "band_limit": "smooth", "pad": 3.0}),
+    ("horn-band", SAND, "frequency", {"scatterer": "point", "upsample": 2}),
+    ("pw-band", SAND, "kspace", {"scatterer": "point"}),
+    ("pw-band", SAND, "columns", {"scatterer": "point", "upsample": 2}),
+    ("transceiver", SAND, "frequency", {"scatterer": "point", "band_limit": "smooth"}),
+    ("transceiver", SAND, "kspace", {"scatterer": "point", "equalize": True}),
+    ("transceiver", SAND, "stolt", {"scatterer": "point"}),
     ("tilted", SAND, "ground-direct", {"frame": "ground"}),
     ("tilted", LOSSY, "ground-direct", {"frame": "ground", "compensate_loss": True}),
+    ("tilted", SAND, "ground-nufft", {"frame": "ground", "scatterer": "point"}),
     ("tilted", SAND, "ground-nufft", {"frame": "ground"}),
     ("tilted-rows", SAND, "ground-direct", {"frame": "ground"}),
     ("tilted-rows", SAND, "ground-nufft", {"frame": "ground"}),
@@ -132,6 +142,8 @@ SAME = [
     ("transceiver", SAND, "kspace", "frequency", {"equalize": True, "upsample": 2}),
     ("transceiver", SAND, "columns", "frequency", {"equalize": True, "upsample": 2}),
     ("transceiver", None, "columns", "frequency", {}),
+    ("pw-band", SAND, "columns", "frequency", {"scatterer": "point", "upsample": 2}),
+    ("transceiver", SAND, "kspace", "frequency", {"scatterer": "point"}),
     ("tilted", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),
     ("tilted-band", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),
     ("tilted-rows", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),
@@ -206,6 +218,42 @@ def test_forward_is_simulates_kirchhoff_model_of_a_plane(medium, source):
     h = hr.simulate(hr.Scene(med, source, [plate]), ap, F0, include_surface=False)
     got = A @ f.ravel()
     assert np.linalg.norm(got - h.data.ravel()) < 0.01 * np.linalg.norm(h.data)
+
+
+@pytest.mark.parametrize(("medium", "mono", "frame"), [
+    (None, False, "aperture"),
+    (hr.Medium.half_space(0.2, 4 + 0.2j), False, "aperture"),
+    (hr.Medium.half_space(0.2, 4.0), True, "aperture"),
+    (hr.Medium.half_space(0.25, 4.0), False, "ground"),
+    (hr.Medium.half_space(0.25, 4.0), False, "ground-coarse"),   # pixels of 2 cm
+])
+def test_point_unit_is_a_point_targets_amplitude(medium, mono, frame):
+    # scatterer="point": a voxel of reflectivity 1 sends the elements what simulate's
+    # PointTarget of amplitude 1 does (its exact Sommerfeld field), as plane waves
+    # weighted by Weyl's 2 pi i/(kz dA) (a transceiver: the round trip's stationary
+    # phase, 2 pi i/(2 k n L dA)). The smooth band limit on a grid padded 3x leaves
+    # the angular spectrum within 2 % of the exact field here (the sharp cut: 13 %);
+    # the round trip's paraxial spreading adds up to 5 % in the ground (measured 5.3 %);
+    # the tilted array's ground frame 4 %. Bound 8 %: a missing 1/kz, a wrong area, a
+    # conjugated transfer or a wrong index in the spreading is 20 % to O(1).
+    med = medium if medium is not None else hr.Medium.free_space()
+    ground = frame.startswith("ground")
+    pose = hr.Pose((0.0, 0.0, 0.0), tilt=np.radians(30), azimuth=np.radians(90)) \
+        if ground else None
+    ap = hr.Aperture.grid(48, 0.006, monostatic=mono, pose=pose)
+    z = 0.4 if ground else 0.3
+    empty = hr.simulate(hr.Scene(med, hr.PlaneWave(), []), ap, F0, include_surface=False)
+    where = {"frame": "ground"} if ground else {"band_limit": "smooth", "pad": 3.0}
+    if frame == "ground-coarse":   # coarser than the spectrum needs: every m-th sample
+        where.update(x=np.arange(-0.2, 0.2001, 0.02), y=np.arange(-0.1, 0.3001, 0.02))
+    A = hr.migration_operator(empty, [z], medium=medium, scatterer="point", **where)
+    ix, iy = A.x.size // 2 + 3, A.y.size // 2 - 2
+    point = hr.PointTarget((A.x[ix], A.y[iy], z), 1.0)
+    h = hr.simulate(hr.Scene(med, hr.PlaneWave(), [point]), ap, F0, include_surface=False)
+    r = np.zeros(A.image_shape, complex)
+    r[0, iy, ix] = 1.0
+    got = A @ r.ravel()
+    assert np.linalg.norm(got - h.data.ravel()) < 0.08 * np.linalg.norm(h.data)
 
 
 def test_scipy_and_pylops_solvers_take_it():

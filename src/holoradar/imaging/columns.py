@@ -200,7 +200,8 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
 
 def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
                     zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
-                    pad: Any, upsample: int, work: np.dtype, incident: str) -> np.ndarray:
+                    pad: Any, upsample: int, work: np.dtype, incident: str,
+                    point_area: float | None = None) -> np.ndarray:
     """The coherent wideband image on uniform planes ``zs`` by the compiled column sum.
 
     Parameters
@@ -224,6 +225,9 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
         As in :func:`holoradar.migrate` (``work`` the working dtype).
     incident : {"none", "phase", "field"}
         A receiver array's normal plane wave factor (:func:`.kspace.frequency_terms`).
+    point_area : float, optional
+        A receiver array's voxels as point scatterers of that cell, square metres
+        (:func:`.kspace.frequency_terms`).
 
     Returns
     -------
@@ -241,8 +245,8 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
     u = int(upsample)
     direct = u == 1 and grid == (ny, nx)
     key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
-           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, direct,
-           work.str, tuple(weights != 0))
+           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
+           direct, work.str, tuple(weights != 0))
     plan = TRANSFER_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
@@ -326,10 +330,12 @@ class ColumnPlan:
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
               z0: float, dz: float, nz: int, medium: Medium, mono: bool, incident: str,
-              direct: bool, work: np.dtype, used: np.ndarray) -> ColumnPlan:
+              point_area: float | None, direct: bool, work: np.dtype,
+              used: np.ndarray) -> ColumnPlan:
         Mx = grid[1]
         gain_q, step_q, jmax, unfold = kspace.frequency_terms(
-            grid, dx, dy, ks, z0, dz, nz, medium, mono, incident, work, used, TINY[work.char])
+            grid, dx, dy, ks, z0, dz, nz, medium, mono, incident, work, used, TINY[work.char],
+            point_area)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Deepest-reaching first (stable: grid order among equals), so that the blocks

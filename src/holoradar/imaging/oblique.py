@@ -33,6 +33,7 @@ cannot reach the ground.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,6 +46,7 @@ from ..data.hologram import Hologram
 from ..physics.medium import Medium
 from ..physics.propagation import (
     TRANSFER_CACHE,
+    band_taper,
     basis_of,
     lateral_travel,
     make_angular_transfer,
@@ -190,7 +192,8 @@ def ground_setup(geometry: Hologram, k: float, zs: np.ndarray, medium: Medium, *
 
 
 def adjoint_ground(geometry: Hologram, data: np.ndarray, g: GroundGrid, zs: np.ndarray, *,
-                   snr: float | None, work: np.dtype, route: str) -> np.ndarray:
+                   snr: float | None, work: np.dtype, route: str,
+                   unit: Callable[[float], Any] | None = None) -> np.ndarray:
     """One frequency's image of posed data ``(B, ny, nx)`` on horizontal world planes
     ``zs``: ``(B, nz, ny', nx')`` on ``g``'s output grid.
 
@@ -198,19 +201,25 @@ def adjoint_ground(geometry: Hologram, data: np.ndarray, g: GroundGrid, zs: np.n
     adjoint. ``route``: how the data's spectrum on the reference plane is summed:
     ``"direct"`` (the factored sums, exact to rounding) or ``"nufft"`` (finufft,
     relative error ``oblique_nufft.EPS``: 1e-6 in complex128, 1e-5 in complex64).
+    ``unit``: a voxel's factor on the world grid at range z (the point unit of
+    :mod:`holoradar.imaging.migration.units`), or None (the plane's reflectivity).
     """
     H = spectrum_on_plane(geometry, data, g, work, route)
     out = np.empty((data.shape[0], zs.size, g.y.size, g.x.size), dtype=work)
     my, mx = g.down
     for j, z in enumerate(zs):
-        full = _inverse_upsampled(H * g.transfer(z, work, snr), g.up, g.crop, g.workers)
+        U = g.transfer(z, work, snr)
+        if unit is not None:
+            U = U * np.conj(unit(float(z)))
+        full = _inverse_upsampled(H * U, g.up, g.crop, g.workers)
         # ifft2 gives the kernel times the grid's cell area: scaled to the output's.
         out[:, j] = full[..., ::my, ::mx] * (mx * my) if mx * my > 1 else full
     return out
 
 
 def forward_ground(geometry: Hologram, image: np.ndarray, g: GroundGrid, zs: np.ndarray, *,
-                   snr: float | None, work: np.dtype, route: str) -> np.ndarray:
+                   snr: float | None, work: np.dtype, route: str,
+                   unit: Callable[[float], Any] | None = None) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_ground`: world planes ``(B, nz, ny', nx')`` ->
     samples at the posed elements ``(B, ny, nx)``.
 
@@ -230,7 +239,10 @@ def forward_ground(geometry: Hologram, image: np.ndarray, g: GroundGrid, zs: np.
         placed[:, ::my, ::mx] = image[:, j] * (mx * my) if mx * my > 1 else image[:, j]
         R = fold(fold(fft2_padded(placed, (uy * My, ux * Mx), work, g.workers), uy, -2),
                  ux, -1)
-        acc += R * np.conj(g.transfer(z, work, snr))
+        U = g.transfer(z, work, snr)
+        if unit is not None:
+            U = U * np.conj(unit(float(z)))
+        acc += R * np.conj(U)
     return spectrum_at_elements(geometry, acc / (My * Mx), g, work, route)
 
 
@@ -287,35 +299,18 @@ def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float
         # The shift to the lowest element (t) and to the highest (t + up).
         up = np.where(kz0 > 0, rise / np.where(kz0 > 0, kz0, 1), np.inf)
         ap, aq = b.p[None, :], b.q[:, None]
-        wx = _taper(ap * t, ap * (t + up), reach[0], Mx * dx - reach[0])
-        wy = _taper(aq * t, aq * (t + up), reach[1], My * dy - reach[1])
+        wx = band_taper(ap * t, ap * (t + up), reach[0], Mx * dx - reach[0])
+        wy = band_taper(aq * t, aq * (t + up), reach[1], My * dy - reach[1])
         # Evanescent across the air but travelling in the ground (a small air gap):
         # they shift only in the ground, and alias as any other component would.
         tg = (0.5 * lateral_travel(k, medium, b.kappa2 / 4, z, below_surface=True) if mono
               else lateral_travel(k, medium, b.kappa2, z, below_surface=True))
-        ge = _taper(ap * tg, ap * tg, reach[0], Mx * dx - reach[0]) \
-            * _taper(aq * tg, aq * tg, reach[1], My * dy - reach[1])
+        ge = band_taper(ap * tg, ap * tg, reach[0], Mx * dx - reach[0]) \
+            * band_taper(aq * tg, aq * tg, reach[1], My * dy - reach[1])
     w_ev = np.where(np.isfinite(tg), ge, 1.0)      # 1: evanescent all the way down
     mask = np.where(b.evanescent, w_ev, wx * wy).ravel()[b.unfold].reshape(grid)
     mask.setflags(write=False)
     return mask
-
-
-def _taper(low: np.ndarray, high: np.ndarray, needed: float, limit: float) -> np.ndarray:
-    """Weight of components whose shift is ``low`` to the lowest element and
-    ``high`` to the highest: 1 while a pixel-element pair may need them
-    (``low <= needed``), 0 once their periodic alias could reach a pixel
-    (``high >= limit``), a raised cosine between. The components it tapers are
-    used by no pair; the smooth edge keeps the kernel from ringing back into the
-    pairs that are (a sharp cut does, by a few percent)."""
-    room = limit - (high - low) - needed
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f = np.where(room > 0, (low - needed) / np.where(room > 0, room, 1.0),
-                     np.where(low <= needed, 0.0, 1.0))
-    f = np.nan_to_num(np.clip(f, 0.0, 1.0), nan=1.0)
-    w = 0.5 * (1 + np.cos(np.pi * f))
-    return np.where(np.isfinite(high) & (high < limit) | (low <= needed) & (high < limit),
-                    w, 0.0)
 
 
 def _shifted(medium: Medium, z_ref: float) -> Medium:

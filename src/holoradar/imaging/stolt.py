@@ -79,14 +79,14 @@ class _Terms:
     @classmethod
     def build(cls, shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray,
               zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, pad: Any,
-              work: np.dtype, incident: str) -> _Terms:
+              work: np.dtype, incident: str, point_area: float | None = None) -> _Terms:
         dx, dy = pitch
         grid = kspace.band_grid(shape, pitch, ks, mono, pad, float(zs.max()))
         nz = zs.size
         dz = float(zs[1] - zs[0])
         gain_q, step_q, jmax, unfold = kspace.frequency_terms(
             grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), dz, nz, medium, mono,
-            incident, work, np.asarray(weights) != 0)
+            incident, work, np.asarray(weights) != 0, point_area=point_area)
         live = np.flatnonzero((jmax >= 0).any(axis=0))
         q_idx = unfold[live]
         jm = jmax[:, live]
@@ -129,7 +129,8 @@ class _Terms:
 
 def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
                   zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
-                  pad: Any, upsample: int, work: np.dtype, incident: str) -> np.ndarray:
+                  pad: Any, upsample: int, work: np.dtype, incident: str,
+                  point_area: float | None = None) -> np.ndarray:
     """The coherent wideband image on uniform planes ``zs`` by Stolt's resampling.
 
     Parameters
@@ -166,7 +167,8 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     every component is live at the first planes). ``"auto"`` stays within ~2x.
     """
     ny, nx = data.shape[-2:]
-    T = _Terms.build((ny, nx), pitch, ks, zs, medium, mono, weights, pad, work, incident)
+    T = _Terms.build((ny, nx), pitch, ks, zs, medium, mono, weights, pad, work, incident,
+                     point_area)
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
     nz, nc = zs.size, T.live.size
@@ -220,7 +222,7 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
 def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float, float],
                   ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
                   weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
-                  incident: str) -> np.ndarray:
+                  incident: str, point_area: float | None = None) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_stolt`: image ``(B, nz, oy, ox)`` -> samples
     ``(B, nf, ny, nx)``.
 
@@ -230,7 +232,8 @@ def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float,
     nodes with the conjugate weights); the rest's conjugate steps; the conjugate gains
     and weights; one inverse FFT per frequency.
     """
-    T = _Terms.build(shape, pitch, ks, zs, medium, mono, weights, pad, work, incident)
+    T = _Terms.build(shape, pitch, ks, zs, medium, mono, weights, pad, work, incident,
+                     point_area)
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
     nz, nc, nf = zs.size, T.live.size, len(ks)

@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import oblique, oblique_sum
 from ..oblique import GroundGrid
-from . import illumination
+from . import illumination, units
 from .backend import Backend
 from .plan import MigrationPlan
 
@@ -43,6 +43,17 @@ class GroundDirect(Backend):
                 for k in plan.wavenumbers]
         return plan.memo["ground"]
 
+    def _unit(self, plan: MigrationPlan, g: GroundGrid):
+        """The point unit's factor of a voxel at world range z on ``g``'s world grid (the
+        range from the reference plane; the cell of an output pixel on that grid,
+        ``dx dy m_x m_y``, as the forward map places it), or None."""
+        if not units.is_point(plan):
+            return None
+        my, mx = g.down
+        area = g.pitch[0] * g.pitch[1] * mx * my
+        return lambda z: units.point_factor(g.grid, g.pitch, g.k, g.medium, z - g.z_ref,
+                                            g.mono, area, plan.work)
+
     def axes(self, plan: MigrationPlan) -> tuple[np.ndarray, np.ndarray]:
         g = self.grids(plan)[0]
         return g.x, g.y
@@ -56,7 +67,8 @@ class GroundDirect(Backend):
         parts = []
         for i, g in enumerate(self.grids(plan)):
             img = oblique.adjoint_ground(plan.geometry, data[:, i], g, plan.z,
-                                         snr=plan.snr_db, work=plan.work, route=self.route)
+                                         snr=plan.snr_db, work=plan.work, route=self.route,
+                                         unit=self._unit(plan, g))
             phasor = illumination.on_planes(plan, i, x, y)
             if phasor is not None:
                 img = img * phasor
@@ -81,7 +93,7 @@ class GroundDirect(Backend):
                 r = plan.weights[i] * r
             out[:, i] = oblique.forward_ground(plan.geometry, r.astype(plan.work, copy=False),
                                                g, plan.z, snr=plan.snr_db, work=plan.work,
-                                               route=self.route)
+                                               route=self.route, unit=self._unit(plan, g))
         return out
 
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import columns, kspace, stolt
-from . import illumination
+from . import illumination, units
 from .backend import Backend, uniform_planes
 from .plan import MigrationPlan
 
@@ -56,6 +56,8 @@ class PhaseShift(Backend):
             lossy = sum(complex(e).imag != 0 for e in plan.medium.eps)
             why.append(f"no loss to compensate ({lossy} lossy layer(s); give "
                        "compensate_loss=False)")
+        if plan.settings.band_limit != "sharp":
+            why.append("band_limit='sharp' (the recurrence drops a component at one plane)")
         if not illumination.is_uniform(plan):
             src = type(plan.geometry.source).__name__
             why.append("a transceiver, or a receiver array lit by a plane wave at normal "
@@ -68,16 +70,42 @@ class PhaseShift(Backend):
 
     def _args(self, plan: MigrationPlan) -> tuple:
         g = plan.geometry
-        return (g.pitch, plan.wavenumbers, plan.z, plan.local, g.monostatic, plan.weights)
+        weights = plan.weights
+        if units.is_point(plan) and plan.monostatic:
+            # The transceiver's point unit 2 pi i/(2 k n L dA) factors into a real weight
+            # per frequency, pi/(k dA), and a factor per plane, i/(n L) (_planes).
+            weights = weights * np.pi / (plan.wavenumbers * g.pitch[0] * g.pitch[1])
+        return (g.pitch, plan.wavenumbers, plan.z, plan.local, g.monostatic, weights)
 
     def _options(self, plan: MigrationPlan) -> dict:
+        g = plan.geometry
+        point = units.is_point(plan) and not plan.monostatic
         return {"pad": plan.pad, "upsample": plan.settings.upsample, "work": plan.work,
-                "incident": self._incident(plan)}
+                "incident": self._incident(plan),
+                "point_area": g.pitch[0] * g.pitch[1] if point else None}
+
+    def _planes(self, plan: MigrationPlan) -> np.ndarray | None:
+        """A transceiver's point unit's factor per plane, ``i/(n_m L)`` (None: 1)."""
+        if not (units.is_point(plan) and plan.monostatic):
+            return None
+        m = plan.local
+        f = np.array([1j / (m.n(int(m.region_of(float(z)))).real * m.apparent_distance(float(z)))
+                      for z in plan.z])
+        return f.astype(plan.work)[:, None, None]
 
     def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
-        return kspace.adjoint_kspace(data, *self._args(plan), **self._options(plan))
+        out = self._adjoint(plan, data)
+        c = self._planes(plan)
+        return out if c is None else np.multiply(out, np.conj(c), out=out)
 
     def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+        c = self._planes(plan)
+        return self._forward(plan, image if c is None else image * c)
+
+    def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+        return kspace.adjoint_kspace(data, *self._args(plan), **self._options(plan))
+
+    def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
         return kspace.forward_kspace(image, plan.grid, *self._args(plan),
                                      **self._options(plan), tiny=self.tiny)
 
@@ -104,10 +132,10 @@ class Columns(PhaseShift):
             why.append("numba (not installed)")
         return "; ".join(why) if why else None
 
-    def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+    def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
         return columns.adjoint_columns(data, *self._args(plan), **self._options(plan))
 
-    def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+    def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
         return kspace.forward_kspace(image, plan.grid, *self._args(plan),
                                      **self._options(plan), tiny=columns.TINY[plan.work.char])
 
@@ -127,10 +155,10 @@ class Stolt(PhaseShift):
                        "phase of each frequency cannot be compensated)")
         return "; ".join(why) if why else None
 
-    def adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+    def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
         return stolt.adjoint_stolt(data, *self._args(plan), **self._options(plan))
 
-    def forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
+    def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
         return stolt.forward_stolt(image, plan.grid, *self._args(plan), **self._options(plan))
 
     def method(self, plan: MigrationPlan) -> str:

@@ -31,7 +31,7 @@ from ..._lazy import lazy_module
 from ..._threads import pool
 from ...physics.propagation import AngularSpectrum, Fresnel, _PlaneOperator
 from ...physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
-from . import illumination
+from . import illumination, units
 from .backend import Backend
 from .plan import MigrationPlan
 
@@ -56,6 +56,8 @@ class PlaneByPlane(Backend):
             return "the aperture's own frame (frame='aperture')"
         if plan.settings.method != "angular":
             return f"method='angular' (got {plan.settings.method!r})"
+        if plan.settings.band_limit == "smooth" and plan.settings.fov == "full":
+            return "fov='aperture' for band_limit='smooth' (its taper is sized by the aperture)"
         return None
 
     # ------------------------------------------------------------------ geometry
@@ -68,10 +70,12 @@ class PlaneByPlane(Backend):
             g = plan.geometry
             dx, dy = g.pitch
             snr = plan.snr_db
+            smooth = plan.settings.band_limit == "smooth"
             op = plan.memo[key] = self.propagator_class(
                 plan.grid, dx, dy, float(plan.wavenumbers[i]), plan.z, plan.local, plan.pad,
                 plan.work, compensate_loss=snr is not None,
-                snr_db=40.0 if snr is None else snr, monostatic=g.monostatic)
+                snr_db=40.0 if snr is None else snr, monostatic=g.monostatic,
+                band_limit="smooth" if smooth else True)
         return op
 
     def _frame(self, plan: MigrationPlan, grid: tuple[int, int]) -> tuple[int, int, int, int]:
@@ -104,7 +108,8 @@ class PlaneByPlane(Backend):
         ops = [self.propagator(plan, i) for i in range(nf)]
         bar = _Progress(plan, nf)
         try:
-            if nf == 1 and plan.illumination == "none" and plan.weights[0] == 1:
+            if nf == 1 and plan.illumination == "none" and plan.weights[0] == 1 and \
+                    not units.is_point(plan):
                 return self._plane_images(plan, ops[0], data[:, 0], bar)
             if not plan.separate and illumination.is_uniform(plan) and \
                     _spectra_fit(ops, data.shape[0], plan.work):
@@ -119,7 +124,8 @@ class PlaneByPlane(Backend):
         acc: np.ndarray | None = None
         parts = []
         for i, op in enumerate(ops):
-            img = self._plane_images(plan, op, data[:, i], bar)
+            img = self._plane_images(plan, op, data[:, i], bar,
+                                     self.effective(plan, ops, i, fold=False))
             phasor = illumination.on_planes(plan, i, x, y)
             if phasor is not None:
                 img = img * phasor
@@ -159,23 +165,34 @@ class PlaneByPlane(Backend):
         assert out is not None
         return out
 
-    def effective(self, plan: MigrationPlan, ops: list[_PlaneOperator], i: int,
-                  forward: bool = False) -> list[np.ndarray]:
-        """Frequency ``i``'s adjoint transfers with its weight and the uniform
-        illumination's ``conj(psi)`` folded in (``forward``: their conjugates, the
-        forward map's), one per plane: kept with the plan while they are small enough
-        (the next call, a solver's next iterate, reuses them)."""
-        key = ("effective", self.name, i, forward)
+    def effective(self, plan: MigrationPlan, ops: list[_PlaneOperator], i: int, *,
+                  forward: bool = False, fold: bool = True) -> list[np.ndarray]:
+        """Frequency ``i``'s adjoint transfers (``forward``: their conjugates, the
+        forward map's), one per plane, with the point unit's factor (``scatterer=
+        "point"``) and, with ``fold``, its weight and the uniform illumination's
+        ``conj(psi)`` folded in: kept with the plan while they are small enough (the
+        next call, a solver's next iterate, reuses them)."""
+        key = ("effective", self.name, i, forward, fold)
         if key in plan.memo:
             return plan.memo[key]
-        Ucs = ops[i].adjoint_transfers
-        w = float(plan.weights[i]) if plan.nf > 1 else 1.0
-        f = illumination.uniform(plan, i)
-        if w == 1.0 and f is None and not forward:
+        op = ops[i]
+        Ucs = op.adjoint_transfers
+        w = float(plan.weights[i]) if plan.nf > 1 and fold else 1.0
+        f = illumination.uniform(plan, i) if fold else None
+        point = units.is_point(plan)
+        if w == 1.0 and f is None and not point and not forward:
             return Ucs
         scale = np.full(len(Ucs), w, dtype=complex) * (1 if f is None else f)
-        out = [np.conj(U * plan.work.type(c)) if forward else U * plan.work.type(c)
-               for U, c in zip(Ucs, scale, strict=True)]
+        out = []
+        for j, (U, c) in enumerate(zip(Ucs, scale, strict=True)):
+            if point:   # conj(S): the adjoint of the point unit's factor
+                S = units.point_factor(op.fft_shape, (op.dx, op.dy), op.k, plan.local,
+                                       float(plan.z[j]), plan.monostatic,
+                                       plan.geometry.pitch[0] * plan.geometry.pitch[1],
+                                       plan.work)
+                U = U * np.conj(S)
+            V = U * plan.work.type(c) if c != 1 else U
+            out.append(np.conj(V) if forward else V)
         for U in out:
             U.setflags(write=False)
         if sum(U.nbytes for U in out) <= _KEEP_BYTES:
@@ -197,8 +214,10 @@ class PlaneByPlane(Backend):
         return planes * (u * u) if u > 1 else planes
 
     def _plane_images(self, plan: MigrationPlan, op: _PlaneOperator, d: np.ndarray,
-                      bar: _Progress) -> np.ndarray:
-        """One frequency's back-propagation ``(B, ny, nx) -> (B, nz, oy, ox)``."""
+                      bar: _Progress, transfers: list[np.ndarray] | None = None
+                      ) -> np.ndarray:
+        """One frequency's back-propagation ``(B, ny, nx) -> (B, nz, oy, ox)`` (by
+        ``transfers``, default the propagator's adjoint ones)."""
         zs = plan.z
         H = op.spectrum(d)
         ny, nx = op.shape
@@ -214,7 +233,7 @@ class PlaneByPlane(Backend):
                                                               dtype=plan.work)
         chunk = zs.size if in_place else _CHUNK
         for c0 in range(0, zs.size, chunk):
-            Ucs = op.adjoint_transfers[c0:c0 + chunk]
+            Ucs = (op.adjoint_transfers if transfers is None else transfers)[c0:c0 + chunk]
             if zs.size == 1:
                 # One plane: multiply into the spectrum itself (ours, no longer needed)
                 # and transform it in place; unpadded it is the image: no allocation.
@@ -254,9 +273,7 @@ class PlaneByPlane(Backend):
                     R = self._spectrum_of(plan, r[:, j], grid, frame, ops[members[0]].workers)
                     these = members if i is None else [i]
                     for m in these:
-                        U = self.effective(plan, ops, m, forward=True)[j] if uniform else \
-                            ops[m].transfers[j] if plan.snr_db is None else \
-                            np.conj(ops[m].adjoint_transfers[j])
+                        U = self.effective(plan, ops, m, forward=True, fold=uniform)[j]
                         if m in acc:
                             acc[m] += R * U
                         elif m == these[-1]:   # R's last use: multiplied in place
@@ -298,6 +315,8 @@ class FresnelPlanes(PlaneByPlane):
             return "the aperture's own frame (frame='aperture')"
         if plan.settings.method != "fresnel":
             return f"method='fresnel' (got {plan.settings.method!r})"
+        if units.is_point(plan) or plan.settings.band_limit == "smooth":
+            return "the angular spectrum for point scatterers or a smooth band limit"
         return None
 
 

@@ -135,6 +135,19 @@ class MigrationSettings:
         ``frame="ground"``: the world grid of the image, metres (uniform).
     progress : bool, optional
         A progress bar (None: only for large outputs).
+    band_limit : {"sharp", "smooth"}
+        How the plane-by-plane angular spectrum drops the components that would wrap
+        around its periodic grid: ``"sharp"`` (default, beyond half the grid) or
+        ``"smooth"`` (a raised cosine from the aperture's extent to where an alias
+        could reach it: an accurate forward model, for inversion, with ``pad`` 3 or
+        more; :class:`~holoradar.AngularSpectrum`).
+    scatterer : {"plane", "point"}
+        The unit of the reflectivity the operator maps: ``"plane"`` (default) the
+        reflection coefficient of a reflecting plane (Kirchhoff: the reflected field
+        on the plane is ``r E0``; ``migrate``'s image); ``"point"`` the Born scattering
+        amplitude of each voxel (a point target's ``amplitude``: the field it sends
+        the elements is ``r E0 G``, ``G`` the Green's function of the layers), so that
+        equal small objects give equal values wherever they lie.
     illumination : {"none", "phase", "field"}, optional
         What the forward model multiplies each voxel's reflectivity by before it
         propagates (and the adjoint by its conjugate): ``"field"`` the source's
@@ -169,6 +182,8 @@ class MigrationSettings:
     y: Any = None
     progress: bool | None = None
     illumination: str | None = None
+    scatterer: str = "plane"
+    band_limit: str = "sharp"
 
     def __post_init__(self) -> None:
         put = object.__setattr__
@@ -192,6 +207,8 @@ class MigrationSettings:
             put(self, "progress", _check_bool(self.progress, "progress"))
         if self.illumination is not None:
             check_choice(self.illumination, "illumination", ILLUMINATIONS)
+        check_choice(self.scatterer, "scatterer", ("plane", "point"))
+        check_choice(self.band_limit, "band_limit", ("sharp", "smooth"))
         if self.frame == "ground":
             self._check_ground()
 
