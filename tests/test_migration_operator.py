@@ -56,6 +56,9 @@ def _holo(kind: str) -> hr.Hologram:
         return hr.Hologram(data(5, 10, 12), x, y, BAND, source=hr.PointSource((0.0, -0.2, -0.05)))
     if kind == "pw-band":       # a receiver array's band lit by a normal plane wave
         return hr.Hologram(data(5, 10, 12), x, y, BAND, source=hr.PlaneWave())
+    if kind == "pw-band-vector":   # the vector model: elements record E_y
+        return hr.Hologram(data(5, 10, 12), x, y, BAND,
+                           source=hr.PlaneWave(polarization=(0, 1, 0)), polarization=(0, 1, 0))
     if kind == "raised":        # a level array 5 cm above the reference plane z = 0
         return hr.Hologram(data(10, 12), x, y, F0, source=hr.PlaneWave(),
                            pose=hr.Pose((0.0, 0.0, 0.05)))
@@ -96,6 +99,8 @@ CASES = [
     ("horn", LOSSY, "frequency", {"scatterer": "point", "band_limit": "smooth", "pad": 3.0}),
     ("horn-band", SAND, "frequency", {"scatterer": "point", "upsample": 2}),
     ("pw-band", SAND, "kspace", {"scatterer": "point"}),
+    ("pw-band-vector", SAND, "columns", {"scatterer": "point"}),
+    ("pw-band-vector", SAND, "frequency", {"scatterer": "point", "band_limit": "smooth"}),
     ("pw-band", SAND, "columns", {"scatterer": "point", "upsample": 2}),
     ("transceiver", SAND, "frequency", {"scatterer": "point", "band_limit": "smooth"}),
     ("transceiver", SAND, "kspace", {"scatterer": "point", "equalize": True}),
@@ -144,6 +149,7 @@ SAME = [
     ("transceiver", None, "columns", "frequency", {}),
     ("pw-band", SAND, "columns", "frequency", {"scatterer": "point", "upsample": 2}),
     ("transceiver", SAND, "kspace", "frequency", {"scatterer": "point"}),
+    ("pw-band-vector", SAND, "kspace", "frequency", {"scatterer": "point"}),
     ("tilted", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),
     ("tilted-band", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),
     ("tilted-rows", SAND, "ground-nufft", "ground-direct", {"frame": "ground"}),

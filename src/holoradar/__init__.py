@@ -34,6 +34,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
         estimate_permittivity,
         suppress_surface,
     )
+    from .imaging.inversion import invert
     from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
     from .imaging.migrate import IlluminationWarning, migrate
     from .imaging.migration.linear import MigrationOperator, migration_operator
@@ -96,6 +97,7 @@ _NAMES = {
     "estimate_permittivity": ".imaging.glare",
     "iq_convention": ".imaging.iq",
     "load": ".io",
+    "invert": ".imaging.inversion",
     "migrate": ".imaging.migrate",
     "migration_operator": ".imaging.migration.linear",
     "permittivity": ".physics.medium",
@@ -162,6 +164,7 @@ __all__ = [
     "conjugate",
     "detect",
     "estimate_permittivity",
+    "invert",
     "iq_convention",
     "load",
     "migrate",

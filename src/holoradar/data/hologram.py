@@ -293,6 +293,9 @@ class Image:
         How the image was formed (e.g. ``"angular"``).
     has_z_axis : bool
         True when ``data`` has the ``nz`` axis (a sequence of ranges was asked).
+    history : tuple of dict
+        What made the image beyond its method, step by step (an inversion's solver,
+        its iterations, residual and stop reason); saved with it.
 
     Examples
     --------
@@ -309,6 +312,7 @@ class Image:
     frequency: float | np.ndarray
     method: str = "angular"
     has_z_axis: bool = True
+    history: tuple = ()
 
     @property
     def intensity(self) -> np.ndarray:

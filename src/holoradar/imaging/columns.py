@@ -201,7 +201,8 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
 def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
                     zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
                     pad: Any, upsample: int, work: np.dtype, incident: str,
-                    point_area: float | None = None) -> np.ndarray:
+                    point_area: float | None = None,
+                    pol: tuple[float, float] | None = None) -> np.ndarray:
     """The coherent wideband image on uniform planes ``zs`` by the compiled column sum.
 
     Parameters
@@ -228,6 +229,8 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
     point_area : float, optional
         A receiver array's voxels as point scatterers of that cell, square metres
         (:func:`.kspace.frequency_terms`).
+    pol : (float, float), optional
+        The vector model's recorded component (its x, y): the dipole factor.
 
     Returns
     -------
@@ -246,7 +249,7 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
     direct = u == 1 and grid == (ny, nx)
     key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
-           direct, work.str, tuple(weights != 0))
+           pol, direct, work.str, tuple(weights != 0))
     plan = TRANSFER_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
@@ -330,12 +333,12 @@ class ColumnPlan:
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
               z0: float, dz: float, nz: int, medium: Medium, mono: bool, incident: str,
-              point_area: float | None, direct: bool, work: np.dtype,
+              point_area: float | None, pol: Any, direct: bool, work: np.dtype,
               used: np.ndarray) -> ColumnPlan:
         Mx = grid[1]
         gain_q, step_q, jmax, unfold = kspace.frequency_terms(
             grid, dx, dy, ks, z0, dz, nz, medium, mono, incident, work, used, TINY[work.char],
-            point_area)
+            point_area, pol)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Deepest-reaching first (stable: grid order among equals), so that the blocks

@@ -36,9 +36,12 @@ from .._threads import fft_workers
 from ..physics.medium import Medium
 from ..physics.propagation import (
     TRANSFER_CACHE,
+    inverse_kz,
     lateral_travel,
     padded_shape,
+    spectral_axes,
     spectral_quadrant,
+    spectral_step,
     two_way_transfer,
 )
 from ..physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
@@ -61,7 +64,8 @@ def band_grid(shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray
 def adjoint_kspace(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
                    zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
                    pad: Any, upsample: int, work: np.dtype, incident: str,
-                   point_area: float | None = None) -> np.ndarray:
+                   point_area: float | None = None,
+                   pol: tuple[float, float] | None = None) -> np.ndarray:
     """The coherent image on uniform planes ``zs`` (see the module docstring).
 
     ``data``: ``(B, nf, ny, nx)``; returns ``(B, nz, oy, ox)``. ``incident``: the
@@ -75,7 +79,7 @@ def adjoint_kspace(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     weights = np.asarray(weights, dtype=float)
     key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in ks),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
-           work.str, tuple(weights != 0))
+           pol, work.str, tuple(weights != 0))
     plan = TRANSFER_CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
     Hc = plan.gather(data, weights, work, workers)
     u = int(upsample)
@@ -89,7 +93,8 @@ def forward_kspace(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float
                    ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
                    weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
                    incident: str, tiny: float = _TINY,
-                   point_area: float | None = None) -> np.ndarray:
+                   point_area: float | None = None,
+                   pol: tuple[float, float] | None = None) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_kspace` (and of the compiled sum with its
     ``tiny``): image ``(B, nz, oy, ox)`` -> samples ``(B, nf, ny, nx)``.
 
@@ -105,7 +110,7 @@ def forward_kspace(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float
     w = np.asarray(weights, dtype=float)
     gain, step, jmax, unfold = frequency_terms(
         grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), float(zs[1] - zs[0]),
-        zs.size, medium, mono, incident, work, w != 0, tiny, point_area)
+        zs.size, medium, mono, incident, work, w != 0, tiny, point_area, pol)
     # Conjugated, weighted and on the whole grid: the forward terms.
     cur = np.conj(gain[:, unfold]) * w[:, None].astype(work)
     back = np.conj(step[:, unfold])
@@ -155,12 +160,12 @@ class _Plan:
     @classmethod
     def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
               z0: float, dz: float, nz: int, medium: Medium, mono: bool,
-              incident: str, point_area: float | None, work: np.dtype,
+              incident: str, point_area: float | None, pol: Any, work: np.dtype,
               used: np.ndarray) -> _Plan:
         Mx = grid[1]
         gain, step, jmax, unfold = frequency_terms(grid, dx, dy, ks, z0, dz, nz, medium, mono,
                                                    incident, work, used,
-                                                   point_area=point_area)
+                                                   point_area=point_area, pol=pol)
         nf = len(ks)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
@@ -260,13 +265,15 @@ class _Plan:
 def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
                     z0: float, dz: float, nz: int, medium: Medium, mono: bool,
                     incident: str, work: np.dtype, used: np.ndarray,
-                    tiny: float = _TINY, point_area: float | None = None
+                    tiny: float = _TINY, point_area: float | None = None,
+                    pol: tuple[float, float] | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per frequency, on one quadrant of the spectrum: the conjugate transfer to the
     first plane (a receiver array's: times the conjugate of a normal plane wave's
     incident factor, ``incident`` "phase" ``E0/|E0|`` or "field" ``E0``, or "none";
     with ``point_area``, a receiver array's voxels of that cell as point scatterers:
-    times ``conj(2 pi i/(kz dA))``, :mod:`holoradar.imaging.migration.units`),
+    times ``conj(2 pi i/(kz dA))``, and with ``pol`` the vector model's dipole factor,
+    :mod:`holoradar.imaging.migration.units`),
     the plane-to-plane step ``exp(-i conj(Kz) dz)``, and the last plane each component
     of the full grid takes part in (-1: none; a frequency with ``used[i]`` False
     takes part nowhere). ``tiny``: a term whose weight has fallen below this fraction of
@@ -299,9 +306,13 @@ def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float
             if incident != "none":
                 e0 = complex(medium.vertical_transfer(k, np.array(0.0), 0.0, z0))
                 a = a * (np.conj(e0) / abs(e0) if incident == "phase" else np.conj(e0))
-            if point_area is not None:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    a = a * np.where(Kz != 0, np.conj(2j * np.pi / (Kz * point_area)), 0)
+            if point_area is not None:   # conj of the point unit's 2 pi i <1/kz> / dA
+                a = a * np.conj(2j * np.pi * inverse_kz(
+                    k * n_last, np.sqrt(kappa2), spectral_step(*spectral_axes(
+                        grid, dx, dy))) / point_area)
+        if pol is not None:   # the dipole's G_uu (real: its own conjugate)
+            legs, kk = (2, 2 * k) if mono else (1, k)
+            a = a * (1 - ((pol[0] * p[None, :] + pol[1] * q[:, None]) / kk) ** 2) ** legs
         rate = np.where(Kz.real > 0, 1 / np.where(Kz.real > 0, Kz.real, 1), np.inf)
         s = np.exp(-1j * np.conj(Kz) * dz)
         if not mono and incident == "phase":

@@ -79,14 +79,15 @@ class _Terms:
     @classmethod
     def build(cls, shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray,
               zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, pad: Any,
-              work: np.dtype, incident: str, point_area: float | None = None) -> _Terms:
+              work: np.dtype, incident: str, point_area: float | None = None,
+              pol: tuple[float, float] | None = None) -> _Terms:
         dx, dy = pitch
         grid = kspace.band_grid(shape, pitch, ks, mono, pad, float(zs.max()))
         nz = zs.size
         dz = float(zs[1] - zs[0])
         gain_q, step_q, jmax, unfold = kspace.frequency_terms(
             grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), dz, nz, medium, mono,
-            incident, work, np.asarray(weights) != 0, point_area=point_area)
+            incident, work, np.asarray(weights) != 0, point_area=point_area, pol=pol)
         live = np.flatnonzero((jmax >= 0).any(axis=0))
         q_idx = unfold[live]
         jm = jmax[:, live]
@@ -130,7 +131,8 @@ class _Terms:
 def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
                   zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
                   pad: Any, upsample: int, work: np.dtype, incident: str,
-                  point_area: float | None = None) -> np.ndarray:
+                  point_area: float | None = None,
+                  pol: tuple[float, float] | None = None) -> np.ndarray:
     """The coherent wideband image on uniform planes ``zs`` by Stolt's resampling.
 
     Parameters
@@ -168,7 +170,7 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     """
     ny, nx = data.shape[-2:]
     T = _Terms.build((ny, nx), pitch, ks, zs, medium, mono, weights, pad, work, incident,
-                     point_area)
+                     point_area, pol)
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
     nz, nc = zs.size, T.live.size
@@ -222,7 +224,8 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
 def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float, float],
                   ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
                   weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
-                  incident: str, point_area: float | None = None) -> np.ndarray:
+                  incident: str, point_area: float | None = None,
+                  pol: tuple[float, float] | None = None) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_stolt`: image ``(B, nz, oy, ox)`` -> samples
     ``(B, nf, ny, nx)``.
 
@@ -233,7 +236,7 @@ def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float,
     and weights; one inverse FFT per frequency.
     """
     T = _Terms.build(shape, pitch, ks, zs, medium, mono, weights, pad, work, incident,
-                     point_area)
+                     point_area, pol)
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
     nz, nc, nf = zs.size, T.live.size, len(ks)

@@ -162,9 +162,11 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     import xarray as xr
 
     now = datetime.now(UTC).isoformat(timespec="seconds")
+    # An image's own steps (an inversion's solver, say) come before those given.
+    own = list(getattr(obj, "history", ()) or ())
     steps = [{**step, "holoradar": step.get("holoradar", _version()),
               "time": step.get("time", now)} if isinstance(step, dict) else step
-             for step in (history or [])]
+             for step in own + [s for s in (history or []) if s not in own]]
     attrs: dict[str, Any] = {"Conventions": "CF-1.8", "holoradar_conventions": CONVENTIONS,
                              "holoradar_version": _version(),
                              "iq_convention": "sample = I + iQ (iq index 0, 1); time "

@@ -47,12 +47,14 @@ __all__ = [
     "basis_of",
     "clear_transfer_cache",
     "ifft2_cropped",
+    "inverse_kz",
     "lateral_travel",
     "loss_exponent",
     "make_angular_transfer",
     "padded_shape",
     "spectral_axes",
     "spectral_quadrant",
+    "spectral_step",
     "transfer_cache_bytes",
     "two_way_transfer",
 ]
@@ -98,6 +100,36 @@ def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndar
     """Transverse wavenumbers ``(p, q)`` in rad/m of an FFT grid of ``shape = (ny, nx)``."""
     ny, nx = shape
     return (2 * np.pi * sfft.fftfreq(nx, dx), 2 * np.pi * sfft.fftfreq(ny, dy))
+
+
+def spectral_step(p: np.ndarray, q: np.ndarray) -> float:
+    """The larger of a grid's two wavenumber steps, rad/m (from its axes)."""
+    steps = [abs(float(a[1] - a[0])) for a in (p, q) if np.size(a) > 1]
+    return max(steps, default=1e-9)
+
+
+def inverse_kz(km: complex, kappa: np.ndarray, step: float) -> np.ndarray:
+    """A point source's weight ``1/kz`` per plane wave, ``kz = sqrt(km^2 - kappa^2)``
+    (Weyl's identity), as a grid of spectral ``step`` samples it.
+
+    ``1/kz`` is singular where the waves turn evanescent (``kappa = km``): each sample
+    takes its mean over ``kappa +- step/2``, ``(F(kappa + h) - F(kappa - h)) / 2h`` with
+    ``F = arcsin(kappa / km)`` (whose derivative is ``1/kz`` on both sides of the
+    circle; ``km`` nudged off the real axis so that the branch is ``kz``'s, Im >= 0).
+    The waves evanescent at the source (``kappa > Re(km)``) are left out: a source
+    wavelengths away sends nothing measurable through them except next to the
+    circle, where a periodic grid cannot hold their long-range field.
+
+    Examples
+    --------
+    >>> w = inverse_kz(200.0, np.array([0.0, 100.0, 300.0]), 1.0)
+    >>> np.round((w * 200).real, 4)
+    array([1.    , 1.1547, 0.    ])
+    """
+    h = 0.5 * float(step)
+    kmt = complex(km) + 1e-9j * abs(km)
+    mean = (np.arcsin((kappa + h) / kmt) - np.arcsin((kappa - h) / kmt)) / (2 * h)
+    return np.where(kappa < complex(km).real, mean, 0)
 
 
 def spectral_quadrant(shape: tuple[int, int], dx: float, dy: float

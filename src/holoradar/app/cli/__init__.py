@@ -123,11 +123,24 @@ def main() -> None:
 
 
 def _register() -> None:
-    from . import batch, calibrate, detect, focus, image, info, misc, plot, process, simulate, view
+    from . import (
+        batch,
+        calibrate,
+        detect,
+        focus,
+        image,
+        info,
+        invert,
+        misc,
+        plot,
+        process,
+        simulate,
+        view,
+    )
     from . import report as report_cli
 
-    for module in (misc, simulate, image, process, focus, calibrate, info, plot, batch, detect,
-                   report_cli, view):
+    for module in (misc, simulate, image, invert, process, focus, calibrate, info, plot, batch,
+                   detect, report_cli, view):
         for cmd in module.COMMANDS:
             main.add_command(cmd)
 

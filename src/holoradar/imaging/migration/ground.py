@@ -51,8 +51,9 @@ class GroundDirect(Backend):
             return None
         my, mx = g.down
         area = g.pitch[0] * g.pitch[1] * mx * my
+        pol = units.polarization(plan)
         return lambda z: units.point_factor(g.grid, g.pitch, g.k, g.medium, z - g.z_ref,
-                                            g.mono, area, plan.work)
+                                            g.mono, area, plan.work, pol)
 
     def axes(self, plan: MigrationPlan) -> tuple[np.ndarray, np.ndarray]:
         g = self.grids(plan)[0]

@@ -39,8 +39,7 @@ def is_uniform(plan: MigrationPlan) -> bool:
         return True
     src = _source(plan)
     return (isinstance(src, PlaneWave) and src.alpha == 0.0 and src.beta == 0.0
-            and (plan.settings.frame == "ground" or plan.geometry.pose.is_identity)
-            and not _vector(plan))
+            and (plan.settings.frame == "ground" or plan.geometry.pose.is_identity))
 
 
 def _vector(plan: MigrationPlan) -> bool:
@@ -55,6 +54,13 @@ def uniform(plan: MigrationPlan, i: int) -> np.ndarray | None:
     if plan.illumination == "none":
         return None
     k = float(plan.wavenumbers[i])
+    if _vector(plan):   # the recorded component of the polarised wave, one pixel a plane
+        e0 = _field_at(plan, _source(plan), k, _world(None, np.zeros(1), np.zeros(1),
+                                                      plan.z))[:, 0, 0]
+        if plan.illumination == "phase":
+            return np.divide(e0.conj(), np.abs(e0), out=np.zeros_like(e0),
+                             where=np.abs(e0) > 0)
+        return e0.conj()
     if plan.illumination == "phase":    # conj(E0)/|E0|
         return incident_phasors([_source(plan)], k, plan.medium, np.zeros(1), np.zeros(1),
                                 plan.z)[0, :, 0, 0]

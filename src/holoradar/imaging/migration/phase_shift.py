@@ -56,6 +56,10 @@ class PhaseShift(Backend):
             lossy = sum(complex(e).imag != 0 for e in plan.medium.eps)
             why.append(f"no loss to compensate ({lossy} lossy layer(s); give "
                        "compensate_loss=False)")
+        pol = units.polarization(plan) if units.is_point(plan) else None
+        if pol is not None and pol[0] * pol[1] != 0:
+            why.append("a recorded field component along x or y for point scatterers "
+                       "(its terms are kept on one quadrant of the spectrum)")
         if plan.settings.band_limit != "sharp":
             why.append("band_limit='sharp' (the recurrence drops a component at one plane)")
         if not illumination.is_uniform(plan):
@@ -80,9 +84,11 @@ class PhaseShift(Backend):
     def _options(self, plan: MigrationPlan) -> dict:
         g = plan.geometry
         point = units.is_point(plan) and not plan.monostatic
+        pol = units.polarization(plan) if units.is_point(plan) else None
         return {"pad": plan.pad, "upsample": plan.settings.upsample, "work": plan.work,
                 "incident": self._incident(plan),
-                "point_area": g.pitch[0] * g.pitch[1] if point else None}
+                "point_area": g.pitch[0] * g.pitch[1] if point else None,
+                "pol": None if pol is None else (float(pol[0]), float(pol[1]))}
 
     def _planes(self, plan: MigrationPlan) -> np.ndarray | None:
         """A transceiver's point unit's factor per plane, ``i/(n_m L)`` (None: 1)."""

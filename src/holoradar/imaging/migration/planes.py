@@ -189,7 +189,7 @@ class PlaneByPlane(Backend):
                 S = units.point_factor(op.fft_shape, (op.dx, op.dy), op.k, plan.local,
                                        float(plan.z[j]), plan.monostatic,
                                        plan.geometry.pitch[0] * plan.geometry.pitch[1],
-                                       plan.work)
+                                       plan.work, units.polarization(plan))
                 U = U * np.conj(S)
             V = U * plan.work.type(c) if c != 1 else U
             out.append(np.conj(V) if forward else V)
