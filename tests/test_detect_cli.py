@@ -74,7 +74,7 @@ def test_json_holds_the_records_and_the_metadata(files):
     meta = doc["metadata"]
     assert meta["threshold"] == pytest.approx(files["ref"].attrs["threshold"])
     assert meta["n_cells"] == pytest.approx(files["ref"].attrs["n_cells"])
-    assert meta["model"] == "hologram" and meta["source"] == str(files["img"])
+    assert meta["model"] == "reflectivity:sparse" and meta["source"] == str(files["img"])
     assert meta["medium"]["z_interfaces_m"] == [0.3]
     assert meta["eps_interval"] is None and meta["false_alarm"] == 1e-3
 

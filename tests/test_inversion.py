@@ -61,7 +61,7 @@ def test_two_points_closer_than_the_rayleigh_spacing_are_resolved(two_points):
 def test_a_points_reflectivity_has_no_sidelobes(two_points):
     # One point: outside its cell the adjoint keeps the aperture's sidelobes (-13 dB);
     # the sparse reflectivity nothing above -30 dB.
-    h, z, cell, _ = two_points
+    _h, z, cell, _ = two_points
     one = hr.simulate(hr.Scene(hr.Medium.free_space(), hr.PlaneWave(polarization=Y),
                                [hr.PointTarget((0.003, -0.002, z))]), _array(), F0,
                       snr_db=30, seed=2)

@@ -115,29 +115,30 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
             or max_objects < 1:
         raise ValueError(f"max_objects must be a whole number >= 1, got {max_objects!r}")
     if hologram is not None:
-        from .model import HologramModel
+        from .reflectivity import detect_by_inversion
 
-        model: Any = HologramModel(hologram, vol, medium, dict(migrate_options or {}))
-    else:
-        if migrate_options:
-            raise ValueError("migrate_options needs hologram=")
-        if vol.z.size > 1:
-            if not _wideband(vol):
-                raise ValueError("image: a volume at one frequency needs hologram= (its "
-                                 "range focus is tens of centimetres long: a point's "
-                                 "response along range comes from the hologram); without "
-                                 "it pass one plane, e.g. image.plane(z)")
-            from .stack import detect_planes
+        rows, meta = detect_by_inversion(vol, hologram, medium, dict(migrate_options or {}),
+                                         interval, fa, int(max_objects))
+        return _frame([r for r in rows if r["kind"] in ks], meta, fa)
+    if migrate_options:
+        raise ValueError("migrate_options needs hologram=")
+    if vol.z.size > 1:
+        if not _wideband(vol):
+            raise ValueError("image: a volume at one frequency needs hologram= (its "
+                             "range focus is tens of centimetres long: a point's "
+                             "response along range comes from the hologram); without "
+                             "it pass one plane, e.g. image.plane(z)")
+        from .stack import detect_planes
 
-            def run_plane(plane: Volume, rate: float
-                          ) -> tuple[list[dict[str, Any]], CleanResult, str]:
-                model = _image_model(plane, medium)
-                return (*_one(plane, model, medium, rate, ks, int(max_objects), interval),
-                        model.kind)
+        def run_plane(plane: Volume, rate: float
+                      ) -> tuple[list[dict[str, Any]], CleanResult, str]:
+            model = _image_model(plane, medium)
+            return (*_one(plane, model, medium, rate, ks, int(max_objects), interval),
+                    model.kind)
 
-            rows, meta = detect_planes(vol, run_plane, fa, medium, interval)
-            return _frame(rows, meta, fa)
-        model = _image_model(vol, medium)
+        rows, meta = detect_planes(vol, run_plane, fa, medium, interval)
+        return _frame(rows, meta, fa)
+    model = _image_model(vol, medium)
     rows, result = _one(vol, model, medium, fa, ks, int(max_objects), interval)
     return _frame(rows, {"threshold": float(result.noise.t),
                          "resolution_cell": [float(c) for c in result.noise.cell],

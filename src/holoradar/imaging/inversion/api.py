@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -22,9 +23,9 @@ from ..migration.memory import available_memory
 from ..migration.settings import MigrationSettings
 from .columns import column_norms
 from .noise import noise_std
-from .solvers import least_squares, sparse
+from .solvers import FALSE_ALARM, least_squares, sparse
 
-__all__ = ["METHODS", "invert"]
+__all__ = ["METHODS", "Reflectivity", "invert", "reflectivity"]
 
 METHODS = ("lsqr", "sparse")
 MAX_ITER = {"lsqr": 100, "sparse": 1000}
@@ -85,14 +86,39 @@ def invert(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsq
     Examples
     --------
     >>> import holoradar as hr
-    >>> scene = hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3), 2.0)],
+    >>> scene = hr.Scene(targets=[hr.PointTarget((0.004, 0.004, 0.3), 2.0)],
     ...                  source=hr.PlaneWave())
     >>> h = hr.simulate(scene, hr.Aperture.grid(24, 0.008), 9.9e9, snr_db=40, seed=0)
-    >>> r = hr.invert(h, [0.28, 0.30, 0.32], method="sparse", progress=False)
-    >>> [round(v, 3) for v in r.peak()], round(abs(r.data).max(), 1)
+    >>> r = hr.invert(h, 0.3, method="sparse", progress=False)
+
+    The point's position, and its amplitude (the sum over the voxels it is kept in):
+
+    >>> [round(v, 3) for v in r.peak()], round(float(abs(r.data.sum())), 1)
     ([0.004, 0.004, 0.3], 2.0)
     """
-    _check(hologram, method, max_iter)
+    return reflectivity(hologram, z, medium=medium, method=method, noise=noise,
+                        max_iter=max_iter, progress=progress, **migrate_options).image
+
+
+@dataclass(frozen=True)
+class Reflectivity:
+    """An inversion's result with what a detector needs besides the image."""
+
+    image: Image
+    column_norms: np.ndarray   # c_j, image_shape
+    sigma: float               # the noise's standard deviation per sample
+    threshold: float           # |r_j| c_j above it: not noise (the sparse threshold)
+
+
+def reflectivity(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsqr",
+                 noise: float | None = None, max_iter: int | None = None,
+                 progress: bool | None = None, false_alarm: float = FALSE_ALARM,
+                 need_source: bool = True, **migrate_options: Any) -> Reflectivity:
+    """:func:`invert`, with the column norms, the noise and the noise threshold
+    (``false_alarm``: the chance that noise alone passes it anywhere on the grid).
+    ``need_source=False`` lets a receiver array without a source through, for
+    ``illumination="none"`` (a uniform illumination, carried by the result)."""
+    _check(hologram, method, max_iter, need_source)
     steps = MAX_ITER[method] if max_iter is None else int(max_iter)
     options = _options(hologram, z, migrate_options)
     A = migration_operator(hologram, z, medium=medium, **options)
@@ -103,8 +129,10 @@ def invert(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsq
     sigma, how = noise_std(hologram, min(float(zs.min()), surface), noise)
     d = A.vector(hologram).astype(A.dtype, copy=False)
     c = column_norms(A, _cell_px(A, hologram))
-    solve = least_squares if method == "lsqr" else sparse
-    sol = solve(A, d, sigma, c, steps, progress)
+    if method == "lsqr":
+        sol = least_squares(A, d, sigma, c, steps, progress)
+    else:
+        sol = sparse(A, d, sigma, c, steps, progress, false_alarm)
     out = A.to_image(sol.r)
     step = {"name": "invert", "method": method, "noise_std": sigma, "noise": how,
             "iterations": sol.iterations, "residual": sol.residual,
@@ -112,11 +140,14 @@ def invert(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsq
             "stop": sol.stop, "unit": "Born scattering amplitude per voxel",
             **{k: float(v) for k, v in sol.extra.items()}}
     data = out.data if np.ndim(z) != 0 else out.data[..., 0, :, :]
-    return Image(data, out.x, out.y, zs, out.frequency, f"invert:{method}",
-                 has_z_axis=np.ndim(z) != 0, history=(step,))
+    image = Image(data, out.x, out.y, zs, out.frequency, f"invert:{method}",
+                  has_z_axis=np.ndim(z) != 0, history=(step,))
+    n = c.size
+    return Reflectivity(image, c, sigma,
+                        sigma * math.sqrt(math.log(n) + math.log(1 / false_alarm)))
 
 
-def _check(hologram: Any, method: Any, max_iter: Any) -> None:
+def _check(hologram: Any, method: Any, max_iter: Any, need_source: bool = True) -> None:
     if not isinstance(hologram, Hologram):
         raise ValueError(f"hologram must be a holoradar.Hologram, got {type(hologram).__name__}")
     if method not in METHODS:
@@ -124,7 +155,7 @@ def _check(hologram: Any, method: Any, max_iter: Any) -> None:
     if max_iter is not None and (isinstance(max_iter, bool) or not isinstance(
             max_iter, int | np.integer) or max_iter < 1):
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-    if not hologram.monostatic and hologram.source is None:
+    if need_source and not hologram.monostatic and hologram.source is None:
         raise ValueError("hologram.source is needed: the inversion divides out the "
                          "illumination, so a receiver array's source must be known "
                          "(Hologram(..., source=...)); a scanned transceiver lights the "

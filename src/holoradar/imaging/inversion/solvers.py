@@ -15,7 +15,11 @@ over ``N`` voxels stays below ``sigma sqrt(log N + log(1/p))`` with probability
 ``1 - p`` (each ``|B^H n|^2 / sigma^2`` is exponential): ``eps`` takes ``p = 1 %``, so
 noise alone leaves no voxel. Neighbouring voxels of a grid finer than the resolution
 have nearly parallel columns, so FISTA needs hundreds of steps (two points 0.6 of the
-Rayleigh spacing apart: about a thousand). The L1 penalty shrinks what it keeps by
+Rayleigh spacing apart: about a thousand); after a thousand a single point on a
+grid of half its cell is still spread over its cell (its sum and centroid right).
+Lowering the threshold from high to ``eps`` (continuation) gathers a single point
+into a voxel but lets the first voxel chosen fall between two close points, so it
+is not used. The L1 penalty shrinks what it keeps by
 ``eps``; one scale for the whole solution, the least-squares fit of its data to the
 data, undoes that on average (a refit of every kept voxel apart was tried: along a
 single frequency's line of sight the kept voxels' columns are nearly parallel, and
@@ -89,7 +93,7 @@ def least_squares(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: 
 
 
 def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
-           progress: Any = None) -> Solution:
+           progress: Any = None, false_alarm: float = FALSE_ALARM) -> Solution:
     """Column-normalised FISTA with the noise's threshold, then the kept voxels'
     least-squares refit (module docstring)."""
     import pylops
@@ -98,7 +102,7 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     N, M = A.shape[1], d.size
     cf = c.ravel()
     B = pylops.aslinearoperator(A) * pylops.Diagonal((1.0 / cf).astype(A.dtype))
-    eps = sigma * math.sqrt(math.log(N) + math.log(1 / FALSE_ALARM))
+    eps = sigma * math.sqrt(math.log(N) + math.log(1 / false_alarm))
     # The step 1/L, L the largest eigenvalue of B^H B (power iterations).
     L = _largest_eigenvalue(B, progress)
     bar = _bar(progress, max_iter, "invert (sparse)")
@@ -110,8 +114,10 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
 
     first = float(np.abs(B.rmatvec(d)).max()) / L   # the size of the first step
     try:
-        u, iters, _ = fista(B, d, niter=max_iter, eps=eps, alpha=1.0 / L, tol=TOL * first,
-                            callback=tick)
+        # PyLops's FISTA soft-thresholds at eps * alpha / 2 (its objective is
+        # |d - B u|^2 + eps |u|_1): 2 eps for a threshold of eps on ``B^H d``.
+        u, iters, _ = fista(B, d, niter=max_iter, eps=2 * eps, alpha=1.0 / L,
+                            tol=TOL * first, callback=tick)
     finally:
         bar.close()
     support = np.abs(u) > 0

@@ -26,7 +26,8 @@ from scipy.sparse.linalg import LinearOperator
 from ...data.hologram import Hologram, Image
 from .backend import Backend
 from .choose import choose
-from .plan import MigrationPlan, make_plan
+from .plan import MigrationPlan, make_plan, without_data
+from .sampling import decimate, fine_hologram, oversampling, zero_insert
 from .settings import MigrationSettings
 
 __all__ = ["MigrationOperator", "migration_operator"]
@@ -36,7 +37,7 @@ OPERATOR_DEFAULTS = {"compensate_loss": False, "equalize": False, "illumination"
 
 
 def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
-                       settings: MigrationSettings | None = None,
+                       settings: MigrationSettings | None = None, sampling: str = "auto",
                        **options: Any) -> MigrationOperator:
     """The linear map from a reflectivity on the image grid to ``hologram``'s samples.
 
@@ -52,6 +53,16 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
         The layered ground (None: free space).
     settings : MigrationSettings, optional
         All options at once (``options`` then replace some of its fields).
+    sampling : {"auto", "band", "array"}
+        How the field meets the elements. ``"band"``: the field inside the hologram's
+        Nyquist band ``|k| < pi / pitch`` (band-limited; ``migrate``'s adjoint).
+        ``"array"``: the field computed on a grid ``u`` times finer than the pitch
+        (``pitch / u`` at most half the shortest wavelength, a transceiver's
+        ``lambda / 4``) and sampled at the elements, the aliasing of an undersampled
+        array included; the image's pixels are then at most ``pitch / u``.
+        ``"auto"``: ``"array"`` for ``scatterer="point"`` on an undersampled array in
+        its own frame, else ``"band"``. The ground frame always samples the elements
+        exactly.
     **options
         :func:`holoradar.migrate`'s options (``method``, ``pad``, ``upsample``,
         ``fov``, ``frame``, ``x``, ``y``, ``dtype``, ``combine`` ("coherent" or "none"),
@@ -96,9 +107,22 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
     if s.combine == "incoherent":
         raise ValueError("combine='incoherent' is not linear (the root sum of squares of "
                          "the frequencies' images): give combine='coherent' or 'none'")
-    plan = make_plan(hologram, z, medium, s)
+    if sampling not in ("auto", "band", "array"):
+        raise ValueError(f"sampling must be 'auto', 'band' or 'array', got {sampling!r}")
+    u = oversampling(hologram) if s.frame == "aperture" and isinstance(hologram, Hologram) \
+        else 1
+    if sampling == "band" or (sampling == "auto" and s.scatterer != "point"):
+        u = 1
+    if u > 1:
+        if s.compensate_loss:
+            raise ValueError("sampling='array' models the field, not migrate's filter: give "
+                             "compensate_loss=False (or sampling='band')")
+        s = s.replace(upsample=max(1, round(s.upsample / u)))
+        plan = make_plan(fine_hologram(hologram, u), z, medium, s)
+    else:
+        plan = make_plan(hologram, z, medium, s)
     plan.snr_db  # noqa: B018  (estimated now, from the data given: the map is then fixed)
-    return MigrationOperator(plan, choose(plan))
+    return MigrationOperator(plan, choose(plan), sampled=(u, without_data(hologram)))
 
 
 class MigrationOperator(LinearOperator):
@@ -110,6 +134,9 @@ class MigrationOperator(LinearOperator):
         The geometry and settings, fixed.
     backend : Backend
         What computes it.
+    sampled : (int, Hologram), optional
+        ``(u, geometry)``: the plan is ``u`` times finer than the hologram ``geometry``,
+        whose elements are every ``u``-th of its samples (``sampling="array"``).
 
     Attributes
     ----------
@@ -123,14 +150,16 @@ class MigrationOperator(LinearOperator):
         The image's pixel coordinates, metres.
     """
 
-    def __init__(self, plan: MigrationPlan, backend: Backend) -> None:
+    def __init__(self, plan: MigrationPlan, backend: Backend,
+                 sampled: tuple[int, Hologram] | None = None) -> None:
         self.plan = plan
         self.backend = backend
+        self.oversampling, self.geometry = sampled if sampled else (1, plan.geometry)
         self.x, self.y = backend.axes(plan)
         nz = plan.z.size
         self.image_shape = ((plan.nf,) if plan.separate else ()) + (nz, self.y.size,
                                                                     self.x.size)
-        self.data_shape = plan.data_shape
+        self.data_shape = (plan.data_shape[:-2] + self.geometry.data.shape[-2:])
         super().__init__(dtype=plan.work, shape=(math.prod(self.data_shape),
                                                  math.prod(self.image_shape)))
 
@@ -159,12 +188,17 @@ class MigrationOperator(LinearOperator):
         k = X.shape[1]
         img = np.ascontiguousarray(X.T).astype(self.plan.work, copy=False)
         out = self.backend.forward(self.plan, img.reshape((k, *self.image_shape)))
+        if self.oversampling > 1:
+            out = decimate(out, self.oversampling)
         return out.reshape(k, -1).T
 
     def _apply_adjoint(self, Y: np.ndarray) -> np.ndarray:
         k = Y.shape[1]
         data = np.ascontiguousarray(Y.T).astype(self.plan.work, copy=False)
-        out = self.backend.adjoint(self.plan, data.reshape((k, self.plan.nf, *self.plan.grid)))
+        data = data.reshape((k, self.plan.nf, *self.geometry.data.shape[-2:]))
+        if self.oversampling > 1:
+            data = zero_insert(data, self.oversampling, self.plan.grid)
+        out = self.backend.adjoint(self.plan, data)
         return out.reshape(k, -1).T
 
     def _matvec(self, x: np.ndarray) -> np.ndarray:
@@ -199,7 +233,7 @@ class MigrationOperator(LinearOperator):
     def to_hologram(self, vector: Any) -> Hologram:
         """A vector of samples (``A @ r``) as a Hologram of this geometry."""
         v = self._checked(vector, "vector", self.shape[0], self.data_shape)
-        g = self.plan.geometry
+        g = self.geometry
         return Hologram(np.asarray(v).reshape(self.data_shape), g.x, g.y, g.frequency,
                         source=g.source, monostatic=g.monostatic, pose=g.pose,
                         polarization=g.polarization)
@@ -215,4 +249,5 @@ class MigrationOperator(LinearOperator):
     def __repr__(self) -> str:
         return (f"<MigrationOperator {self.shape[0]} samples x {self.shape[1]} voxels, "
                 f"image {self.image_shape}, backend {self.backend.name!r}, "
+                f"{'' if self.oversampling == 1 else f'sampled 1 in {self.oversampling}, '}"
                 f"{self.dtype}>")

@@ -1,0 +1,261 @@
+"""Objects found in the reflectivity: ``detect`` with the hologram, on every geometry.
+
+With the hologram, the measurement is inverted on the image's grid
+(:func:`holoradar.invert`): each voxel's Born scattering amplitude, the illumination
+divided out, no sidelobes, no pull towards the array. Objects are then read off the
+reflectivity, not off the adjoint image's amplitude:
+
+* the voxels above the noise (``|r_j| c_j`` above the threshold that noise alone
+  passes nowhere on the grid but with probability ``p``, ``c_j`` the operator's
+  column norm; the sparse inversion keeps only such voxels) are joined into objects
+  when they lie within half a resolution cell of each other laterally and within a
+  range cell in range (a bar's voxels, kept sparsely along it, make one object);
+* each object's position is its voxels' centroid weighted by ``|r|^2``; its lateral
+  extents along and across its principal axis (weighted second moments, the full
+  width ``sqrt(12)`` standard deviations of a uniform bar, at least one voxel) make
+  it a line (longer than two cells and three times its width), an area (both extents
+  over two cells) or a point;
+* a point under a level array is refined by the exact point response fitted to the
+  hologram (:class:`~.model.HologramModel`: no grid, the Cramer-Rao standard
+  deviations); elsewhere its position's standard deviation is that of a peak of the
+  resolution cell's width at the object's SNR, ``cell sqrt(3 / (2 SNR)) / pi``;
+* the amplitude is the object's Born amplitude, ``|sum_j r_j|``; its SNR
+  ``sum |r_j c_j|^2 / sigma^2`` (the matched filter's).
+
+The sparse inversion is used up to :data:`SPARSE_VOXELS` voxel-frequencies (it
+resolves, and its support is the object); beyond, damped least squares, thresholded.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..._lazy import lazy_module
+from ...data.hologram import C0
+from .grid import Volume
+from .table import depth_interval
+
+ndimage = lazy_module("scipy.ndimage")
+
+__all__ = ["SPARSE_VOXELS", "detect_by_inversion"]
+
+SPARSE_VOXELS = 3_000_000
+GRID_CELLS = 0.5
+MAX_ITER = 300
+
+
+def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any],
+                        interval: tuple[float, float] | None, false_alarm: float,
+                        max_objects: int) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Rows of ``detect``'s table and its attributes (see the module docstring)."""
+    from ...imaging.inversion.api import reflectivity
+
+    grid, level = _grid(vol, hologram, medium, options)
+    model = None
+    if level:
+        from .model import HologramModel
+
+        # The image must be this hologram's migration (checked on a few planes):
+        # otherwise its planes and pixels say nothing of where the inversion looks.
+        model = HologramModel(hologram, vol, medium, dict(options))
+        model.start()
+    n_vox = vol.z.size * len(grid.get("y", vol.y)) * len(grid.get("x", vol.x))
+    method = "sparse" if n_vox * hologram.nf <= SPARSE_VOXELS else "lsqr"
+    cell = _lateral_cell(hologram, medium, float(np.median(vol.z)))
+    n_cells = max(1.0, (np.ptp(vol.x) * np.ptp(vol.y)) / cell**2) * vol.z.size
+    p = min(0.5, false_alarm * n_cells)
+    zs = vol.z if not vol.planar else float(vol.z[0])
+    if not hologram.monostatic and hologram.source is None:
+        # The source unknown: its illumination taken as uniform (each object's amplitude
+        # then carries it), said in the table's attributes.
+        grid["illumination"] = "none"
+    res = reflectivity(hologram, zs, medium=medium, method=method, progress=False,
+                       max_iter=MAX_ITER if method == "sparse" else None,
+                       false_alarm=p, need_source=False, **grid)
+    r = res.image
+    data = r.data if r.has_z_axis else r.data[None]
+    strength = np.abs(data) * res.column_norms.reshape(data.shape)
+    keep = (np.abs(data) > 0) if method == "sparse" else strength > res.threshold
+    objects = _objects(data, keep, r, cell, hologram, medium, max_objects,
+                       res.column_norms.reshape(data.shape))
+    # An object is the noise's only if its matched-filter energy is below what noise
+    # alone passes with probability p on the grid (the voxels' threshold, squared).
+    objects = [ob for ob in objects
+               if float(np.sum(ob["w"] * ob["c"] ** 2)) > res.threshold ** 2]
+    rows = [_row(ob, res.sigma, medium, interval, hologram) for ob in objects]
+    if model is not None and any(row["kind"] == "point" for row in rows):
+        _refine_points(rows, model, medium, interval, hologram.nf > 1)
+    _spacing(rows)
+    step = r.history[0]
+    meta = {"threshold": float(res.threshold), "noise_std": float(res.sigma),
+            "resolution_cell": [cell, cell, _range_cell(hologram, medium, float(np.median(vol.z)))
+                                    if hologram.nf > 1 else None], "n_cells": float(n_cells),
+            "model": f"reflectivity:{method}", "inversion": dict(step),
+            "illumination": grid.get("illumination", "field")}
+    return rows, meta
+
+
+def _grid(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any]
+          ) -> tuple[dict[str, Any], bool]:
+    """The inversion's grid: the image's planes; pixels of a quarter of the lateral
+    resolution cell at the shallowest plane (a point then lies within an eighth of a
+    cell of a voxel: the sparse solution keeps it in one or two voxels instead of
+    spreading it to fit the difference); a tilted array's ground frame, its region the
+    image's."""
+    quarter = GRID_CELLS * _lateral_cell(hologram, medium, float(np.min(vol.z)))
+    level = bool(hologram.pose.is_identity) and not vol.method.endswith(":ground") and \
+        options.get("frame", "aperture") == "aperture"
+    if level:
+        pitch = max(hologram.pitch)
+        return {"upsample": max(1, min(8, math.ceil(pitch / quarter)))}, True
+    step = max(1, math.floor(quarter / vol.dx))
+    return {"frame": "ground", "x": vol.x[::step], "y": vol.y[::step]}, False
+
+
+def _lateral_cell(hologram: Any, medium: Any, z: float) -> float:
+    """``lambda L / A`` at range ``z`` (the centre frequency; L apparent in the ground)."""
+    lam = C0 / float(np.mean(hologram.frequencies))
+    L = medium.apparent_distance(z) if medium is not None else z
+    return lam * L / max(min(hologram.aperture_size), 1e-9)
+
+
+def _range_cell(hologram: Any, medium: Any, z: float) -> float:
+    """The depth response: ``c / (2 B n)`` across a band, one frequency's
+    ``4.97 lambda (L / A)^2``."""
+    n = float(medium.n(int(medium.region_of(z))).real) if medium is not None else 1.0
+    f = hologram.frequencies
+    if f.size > 1:
+        return C0 / (2 * float(np.ptp(f)) * n)
+    L = medium.apparent_distance(z) if medium is not None else z
+    return 4.97 * C0 / float(f[0]) * (L / max(min(hologram.aperture_size), 1e-9)) ** 2
+
+
+def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: Any,
+             medium: Any, max_objects: int, c: np.ndarray) -> list[dict[str, Any]]:
+    """Voxels above the noise joined into objects, strongest first."""
+    if not keep.any():
+        return []
+    dx = float(abs(r.x[1] - r.x[0])) if r.x.size > 1 else cell
+    dz = float(np.min(np.diff(r.z))) if r.z.size > 1 else 1.0
+    reach = max(1, round(0.5 * cell / dx))
+    zreach = max(1, round(_range_cell(hologram, medium, float(np.median(r.z))) / 2 / dz))
+    joined = ndimage.binary_dilation(keep, np.ones((2 * zreach + 1, 2 * reach + 1,
+                                                    2 * reach + 1), bool))
+    labels, count = ndimage.label(joined)
+    out = []
+    for lab in range(1, count + 1):
+        sel = keep & (labels == lab)
+        iz, iy, ix = np.nonzero(sel)
+        vals = data[iz, iy, ix]
+        out.append({"w": np.abs(vals) ** 2, "vals": vals, "x": r.x[ix], "y": r.y[iy],
+                    "z": r.z[iz], "c": c[iz, iy, ix], "dx": dx})
+    out.sort(key=lambda ob: -float(ob["w"].sum()))
+    return out[:max_objects]
+
+
+def _row(ob: dict[str, Any], sigma: float, medium: Any, interval: Any,
+         hologram: Any) -> dict[str, Any]:
+    w = ob["w"] / ob["w"].sum()
+    cx, cy, cz = (float(np.sum(w * ob[k])) for k in ("x", "y", "z"))
+    cell = _lateral_cell(hologram, medium, cz)
+    length, width, azimuth, ends = _extent(ob, w, cx, cy)
+    kind = "line" if length > 2 * cell and length > 3 * width else \
+        "area" if min(length, width) > 2 * cell else "point"
+    amp = abs(complex(np.sum(ob["vals"])))
+    snr_lin = float(np.sum(ob["w"] * ob["c"] ** 2)) / sigma**2
+    k = math.sqrt(3 / (2 * snr_lin)) if snr_lin > 0 else math.inf
+    std = (cell * k / math.pi, cell * k / math.pi,
+           _range_cell(hologram, medium, cz) * k / math.pi)
+    depth = lo = hi = np.nan
+    if medium is not None and medium.z_interfaces:
+        depth = cz - float(medium.z_interfaces[0])
+        eps = float(np.real(medium.eps[int(medium.region_of(cz))]))
+        lo, hi = depth_interval(depth, std[2], eps, interval, hologram.nf > 1)
+    line = kind == "line"
+    row = {"kind": kind, "x": cx, "y": cy, "range": cz, "depth": depth, "depth_low": lo,
+           "depth_high": hi, "length": length if kind != "point" else 0.0,
+           "width": width if kind != "point" else 0.0,
+           "azimuth_deg": azimuth if kind != "point" else np.nan,
+           "amplitude_db": 20 * math.log10(max(amp, 1e-300)),
+           "snr_db": 10 * math.log10(snr_lin) if snr_lin > 0 else -np.inf,
+           "x_std": std[0], "y_std": std[1], "range_std": std[2],
+           "x_start": ends[0] if line else np.nan, "y_start": ends[1] if line else np.nan,
+           "x_end": ends[2] if line else np.nan, "y_end": ends[3] if line else np.nan,
+           "spacing": np.nan, "model_error_db": np.nan, "area": np.nan}
+    if kind == "area":
+        row["outline"], row["area"] = _outline(ob)
+    return row
+
+
+def _extent(ob: dict[str, Any], w: np.ndarray, cx: float, cy: float
+            ) -> tuple[float, float, float, tuple[float, float, float, float]]:
+    """Full length and width along and across the principal axis (weighted second
+    moments, sqrt(12) standard deviations, at least one voxel), azimuth (degrees from +x
+    towards +y, in [0, 180)) and the line's ends."""
+    X, Y = ob["x"] - cx, ob["y"] - cy
+    cov = np.array([[np.sum(w * X * X), np.sum(w * X * Y)],
+                    [np.sum(w * X * Y), np.sum(w * Y * Y)]])
+    vals, vecs = np.linalg.eigh(cov)
+    axis = vecs[:, 1]
+    length = max(math.sqrt(12 * max(vals[1], 0.0)), ob["dx"])
+    width = max(math.sqrt(12 * max(vals[0], 0.0)), ob["dx"])
+    azimuth = math.degrees(math.atan2(axis[1], axis[0])) % 180.0
+    half = 0.5 * length
+    ends = (cx - half * axis[0], cy - half * axis[1], cx + half * axis[0], cy + half * axis[1])
+    return length, width, azimuth, ends
+
+
+def _outline(ob: dict[str, Any]) -> tuple[list[tuple[float, float]], float]:
+    """An area's lateral outline (the convex hull of its voxels) and its area, m^2."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.unique(np.stack([ob["x"], ob["y"]], axis=1), axis=0)
+    try:
+        hull = ConvexHull(pts)
+    except (QhullError, ValueError):
+        return [tuple(map(float, p)) for p in pts], 0.0
+    return [tuple(map(float, pts[i])) for i in hull.vertices], float(hull.volume)
+
+
+def _spacing(rows: list[dict[str, Any]]) -> None:
+    """Each line's distance to the nearest parallel line (azimuths within 15 degrees),
+    across its direction."""
+    lines = [r for r in rows if r["kind"] == "line"]
+    for a in lines:
+        best = np.inf
+        for b in lines:
+            if b is a:
+                continue
+            d_az = abs(a["azimuth_deg"] - b["azimuth_deg"]) % 180.0
+            if min(d_az, 180.0 - d_az) > 15.0:
+                continue
+            t = math.radians(a["azimuth_deg"])
+            across = abs(-(b["x"] - a["x"]) * math.sin(t) + (b["y"] - a["y"]) * math.cos(t))
+            best = min(best, across)
+        a["spacing"] = best if np.isfinite(best) else np.nan
+
+
+def _refine_points(rows: list[dict[str, Any]], model: Any, medium: Any,
+                   interval: tuple[float, float] | None, wideband: bool) -> None:
+    """Points under a level array: the exact point response fitted from each one's
+    centroid (strongest first, each subtracted), then refitted together; Cramer-Rao
+    standard deviations."""
+    points = [r for r in rows if r["kind"] == "point"]
+    for row in points:
+        start = (row["x"], row["y"], row["range"])
+        pos = model.fit_position(start, model.res, model._cell(start[2]))
+        _, a, g = model.focus(pos, model.res)
+        model.res = model.res - a[:, None] * g
+        model.objects.append({"r": pos, "a": a, "g": g})
+    model.refine()
+    for row, ob, std in zip(points, model.objects, model.uncertainty(), strict=True):
+        row["x"], row["y"], row["range"] = (float(v) for v in ob["r"])
+        row["x_std"], row["y_std"], row["range_std"] = (float(v) for v in std)
+        if medium is not None and medium.z_interfaces:
+            row["depth"] = row["range"] - float(medium.z_interfaces[0])
+            eps = float(np.real(medium.eps[int(medium.region_of(row["range"]))]))
+            row["depth_low"], row["depth_high"] = depth_interval(
+                row["depth"], row["range_std"], eps, interval, wideband)
