@@ -1,5 +1,5 @@
 """``hr.unbiased_peak``: the object's position by the point-response fit, not the
-image's biased maximum (``Image.peak()``, the brightest voxel); tilted arrays refused."""
+image's biased maximum (``Image.peak()``, the brightest voxel), level and tilted arrays."""
 
 from __future__ import annotations
 
@@ -58,22 +58,47 @@ def test_plain_peak_unchanged_and_bad_calls_refused(level):
     assert img.peak() == (float(img.x[ix]), float(img.y[iy]), float(img.z[iz]))
     with pytest.raises(ValueError, match="hologram="):
         hr.unbiased_peak(img, None)
-    # The brightest voxel is all Image.peak gives: the fit is named in its refusal.
-    with pytest.raises(ValueError, match=r"holoradar\.unbiased_peak"):
-        img.peak(unbiased=True, hologram=h)
-    with pytest.raises(ValueError, match=r"holoradar\.unbiased_peak"):
+    # Image.peak(unbiased=True) is unbiased_peak; without a hologram it is refused, and
+    # a hologram without unbiased=True too (the brightest voxel does not use it).
+    assert img.peak(unbiased=True, hologram=h, medium=SAND) == hr.unbiased_peak(img, h, SAND)
+    with pytest.raises(ValueError, match="needs hologram="):
+        img.peak(unbiased=True)
+    with pytest.raises(ValueError, match="go with unbiased=True"):
         img.peak(hologram=h)
     other = hr.Hologram(h.data[::-1, ::-1].conj(), h.x, h.y, h.frequency)
     with pytest.raises(ValueError, match="not the migration of hologram"):
         hr.unbiased_peak(img, other, SAND)
 
 
-def test_tilted_array_refused(level):
-    # The fit's point response is tabulated for a level aperture: the same array tilted
-    # 35 degrees is refused with the reason (docs/detect.md), never answered with a
-    # wrong position. (The refusal looks at the geometry only: the level case's data
-    # under the tilted pose stand for the tilted array's.)
+def test_tilted_array_needs_its_ground_frame_image(level):
+    # A posed array's objects are found on world planes: an image in the array's own
+    # frame is refused with the way out, never answered with a wrong position. (The
+    # refusal looks at the geometry only: the level case's data under the tilted pose
+    # stand for the tilted array's.)
     h, img = level
-    tilted = hr.Hologram(h.data, h.x, h.y, h.frequency, pose=hr.Pose(tilt=np.radians(35.0)))
-    with pytest.raises(ValueError, match=r"level aperture.*tilted arrays are not supported"):
+    tilted = hr.Hologram(h.data, h.x, h.y, h.frequency, source=hr.PlaneWave(),
+                         pose=hr.Pose(tilt=np.radians(35.0)))
+    with pytest.raises(ValueError, match=r"ground frame.*frame='ground'"):
         hr.unbiased_peak(img, tilted, SAND)
+
+
+def test_unbiased_peak_under_a_tilted_array_from_the_reflectivity():
+    # A 24 x 24 array at 1.25 cm tilted 35 degrees, a point 12 cm deep in sand, one
+    # frequency, imaged in the ground frame: the adjoint's maximum lies short of the
+    # point along the line of sight; the strongest object of the inverted reflectivity
+    # is the point, within a quarter of the lateral cell across and of the one-frequency
+    # depth response ``4.97 lambda (L / A)^2`` along range.
+    sand = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
+    truth = np.array([0.0, 0.05, 0.42])
+    ap = hr.Aperture.grid(24, 0.0125, pose=hr.Pose((0.0, -0.15, 0.05), tilt=np.radians(35),
+                                                    azimuth=np.radians(90)))
+    h = hr.simulate(hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget(tuple(truth))]), ap,
+                    9.9e9, include_surface=False, snr_db=30, seed=4)
+    img = hr.migrate(h, np.arange(0.34, 0.53, 0.02), medium=sand, frame="ground",
+                     x=np.arange(-0.08, 0.0801, 0.01), y=np.arange(-0.03, 0.1301, 0.01))
+    p = img.peak(unbiased=True, hologram=h, medium=sand)
+    L = sand.apparent_distance(truth[2]) + 0.15       # the slant path, roughly
+    lateral, depth = h.wavelength * L / 0.30, 4.97 * h.wavelength * (L / 0.30) ** 2
+    err = np.abs(np.array(p) - truth)
+    assert err[0] < lateral / 4 and err[1] < lateral / 4 and err[2] < depth / 4, err
+    assert all(np.isfinite(p.std))

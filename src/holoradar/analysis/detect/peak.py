@@ -4,10 +4,16 @@ The image's amplitude maximum is biased along the line of sight: at one
 frequency the focus is tens of centimetres long and the adjoint's ``1/r``
 weighting pulls its maximum towards the array (a point 10 cm deep in sand
 under a level 32 x 32 array 50 cm above the sand images brightest 9 cm short
-of it). :func:`unbiased_peak` fits the exact point response to the hologram the
-image came from, starting at the image's brightest pixel: the fit
-:func:`~holoradar.detect` uses (:class:`~.model.HologramModel`, the maximum of
-the normalised matched filter), with its Cramer-Rao standard deviations.
+of it). :func:`unbiased_peak` finds it from the hologram the image came from:
+
+* under a level array, the exact point response fitted to the hologram from the
+  image's brightest pixel (:class:`~.model.HologramModel`, the maximum of the
+  normalised matched filter), with its Cramer-Rao standard deviations;
+* under a tilted array (an image in the ground frame), the strongest object of
+  the inverted reflectivity (:func:`holoradar.detect` with the hologram: no
+  ``1/r`` pull, the illumination divided out), its position the object's
+  centroid, its standard deviations a peak's of the resolution cell at the
+  object's SNR.
 """
 
 from __future__ import annotations
@@ -77,8 +83,8 @@ def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
         One frame: a plane or a volume, ``migrate(hologram, z, medium=medium,
         upsample=u, **migrate_options)``.
     hologram : Hologram
-        The hologram the image was migrated from (one frame, a level array at
-        z = 0 with the identity pose).
+        The hologram the image was migrated from (one frame; a level array at z = 0
+        with the identity pose, or a posed array with the image in the ground frame).
     medium : Medium, optional
         The ground the image was formed through (None: free space).
     migrate_options : mapping, optional
@@ -94,9 +100,8 @@ def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
     Raises
     ------
     ValueError
-        No hologram, a hologram that did not make the image, a tilted or moved
-        array (the fit's point response is tabulated for a level aperture at
-        z = 0 only), several frames.
+        No hologram, a hologram that did not make the image, several frames, no
+        object above the noise (a posed array).
 
     Examples
     --------
@@ -117,8 +122,11 @@ def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
     if hologram is None:
         raise ValueError("unbiased_peak needs hologram= (the hologram the image was "
                          "migrated from): the fit of the point response is made on it")
+    from ...data.hologram import Hologram
     from .model import HologramModel
 
+    if isinstance(hologram, Hologram) and not hologram.pose.is_identity:
+        return _strongest_reflector(image, hologram, medium, migrate_options)
     vol = as_volume(image)
     model = HologramModel(hologram, vol, medium, dict(migrate_options or {}))
     # The image only gives the fit its start: a loose check that it is this hologram's
@@ -141,3 +149,18 @@ def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
     model.objects.append({"r": r, "a": a, "g": g})
     std = model.uncertainty()[0]
     return PeakPosition(r, std, complex(a[0]), F / model.energy(model.h))
+
+
+def _strongest_reflector(image: Any, hologram: Any, medium: Any,
+                         migrate_options: Mapping[str, Any] | None) -> PeakPosition:
+    """A posed array's brightest object: the strongest of the inverted reflectivity."""
+    from .api import detect
+
+    table = detect(image, hologram=hologram, medium=medium, max_objects=1,
+                   migrate_options=dict(migrate_options or {}) or None)
+    if table.empty:
+        raise ValueError("no object above the noise in the reflectivity inverted from "
+                         "hologram on the image's grid: there is no brightest object")
+    row = table.iloc[0]
+    return PeakPosition((row.x, row.y, row["range"]), (row.x_std, row.y_std, row.range_std),
+                        complex(10 ** (row.amplitude_db / 20)), np.nan)

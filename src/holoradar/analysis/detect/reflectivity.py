@@ -35,6 +35,7 @@ import numpy as np
 
 from ..._lazy import lazy_module
 from ...data.hologram import C0
+from .errors import HologramFitError
 from .grid import Volume
 from .table import depth_interval
 
@@ -45,6 +46,9 @@ __all__ = ["SPARSE_VOXELS", "detect_by_inversion"]
 SPARSE_VOXELS = 3_000_000
 GRID_CELLS = 0.5
 MAX_ITER = 300
+#: A weaker object within a resolution cell of a stronger one by more than this (the
+#: energy, dB) is a fragment of it: the aperture's first sidelobe level.
+FRAGMENT_DB = -13.3
 
 
 def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any],
@@ -53,6 +57,11 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     """Rows of ``detect``'s table and its attributes (see the module docstring)."""
     from ...imaging.inversion.api import reflectivity
 
+    if not hologram.pose.is_identity and not vol.method.endswith(":ground"):
+        raise HologramFitError(
+            "image must be in the ground frame of hologram's posed (tilted or moved) array: "
+            "migrate(hologram, z, medium=medium, frame='ground', x=..., y=...); the "
+            "reflectivity is inverted on its world planes", "tilted")
     grid, level = _grid(vol, hologram, medium, options)
     model = None
     if level:
@@ -77,25 +86,37 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
                        false_alarm=p, need_source=False, **grid)
     r = res.image
     data = r.data if r.has_z_axis else r.data[None]
-    strength = np.abs(data) * res.column_norms.reshape(data.shape)
-    keep = (np.abs(data) > 0) if method == "sparse" else strength > res.threshold
-    objects = _objects(data, keep, r, cell, hologram, medium, max_objects,
-                       res.column_norms.reshape(data.shape))
-    # An object is the noise's only if its matched-filter energy is below what noise
-    # alone passes with probability p on the grid (the voxels' threshold, squared).
-    objects = [ob for ob in objects
-               if float(np.sum(ob["w"] * ob["c"] ** 2)) > res.threshold ** 2]
+    c = res.column_norms.reshape(data.shape)
+    energy = (np.abs(data) * c) ** 2
+    step = r.history[0]
+    floor = _floor(res.threshold, step["residual"], step["noise_norm"])
+    # The sparse solution's voxels each passed the threshold on their correlation with
+    # the data (the soft threshold then shrank them by it); least squares' are kept
+    # where they stand above it.
+    support = np.abs(data) > 0 if method == "sparse" else energy > res.threshold**2
+    objects = _merge_fragments(_objects(data, support, r, cell, hologram, medium, c), cell,
+                               _range_cell(hologram, medium, float(np.median(vol.z))))
+    objects = [ob for ob in objects if float(np.sum(ob["w"] * ob["c"] ** 2)) > floor]
+    objects = objects[:max_objects]
     rows = [_row(ob, res.sigma, medium, interval, hologram) for ob in objects]
     if model is not None and any(row["kind"] == "point" for row in rows):
         _refine_points(rows, model, medium, interval, hologram.nf > 1)
     _spacing(rows)
-    step = r.history[0]
     meta = {"threshold": float(res.threshold), "noise_std": float(res.sigma),
             "resolution_cell": [cell, cell, _range_cell(hologram, medium, float(np.median(vol.z)))
                                     if hologram.nf > 1 else None], "n_cells": float(n_cells),
             "model": f"reflectivity:{method}", "inversion": dict(step),
-            "illumination": grid.get("illumination", "field")}
+            "illumination": grid.get("illumination", "field"),
+            "model_error_floor": float(floor)}
     return rows, meta
+
+
+def _floor(threshold: float, residual: float, noise_norm: float) -> float:
+    """The energy ``|r_j c_j|^2`` a voxel needs to seed an object: above the noise's
+    threshold squared, and above what the fit leaves unexplained beyond the noise,
+    ``|A r - d|^2 - M sigma^2`` (the model's error: the sparse fit explains part of it
+    by small spurious voxels, each weaker than what it leaves)."""
+    return max(threshold**2, residual**2 - noise_norm**2)
 
 
 def _grid(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any]
@@ -134,17 +155,17 @@ def _range_cell(hologram: Any, medium: Any, z: float) -> float:
 
 
 def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: Any,
-             medium: Any, max_objects: int, c: np.ndarray) -> list[dict[str, Any]]:
+             medium: Any, c: np.ndarray) -> list[dict[str, Any]]:
     """Voxels above the noise joined into objects, strongest first."""
     if not keep.any():
         return []
     dx = float(abs(r.x[1] - r.x[0])) if r.x.size > 1 else cell
     dz = float(np.min(np.diff(r.z))) if r.z.size > 1 else 1.0
-    reach = max(1, round(0.5 * cell / dx))
-    zreach = max(1, round(_range_cell(hologram, medium, float(np.median(r.z))) / 2 / dz))
-    joined = ndimage.binary_dilation(keep, np.ones((2 * zreach + 1, 2 * reach + 1,
-                                                    2 * reach + 1), bool))
-    labels, count = ndimage.label(joined)
+    # Lateral neighbours touch (the grid's pixels are half a cell); in range, voxels
+    # within half a range cell join.
+    zreach = max(1, math.floor(_range_cell(hologram, medium, float(np.median(r.z))) / 2 / dz))
+    joined = ndimage.binary_dilation(keep, np.ones((2 * zreach + 1, 1, 1), bool))
+    labels, count = ndimage.label(joined, np.ones((3, 3, 3), bool))
     out = []
     for lab in range(1, count + 1):
         sel = keep & (labels == lab)
@@ -152,8 +173,39 @@ def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: 
         vals = data[iz, iy, ix]
         out.append({"w": np.abs(vals) ** 2, "vals": vals, "x": r.x[ix], "y": r.y[iy],
                     "z": r.z[iz], "c": c[iz, iy, ix], "dx": dx})
-    out.sort(key=lambda ob: -float(ob["w"].sum()))
-    return out[:max_objects]
+    out.sort(key=lambda ob: -float(np.sum(ob["w"] * ob["c"] ** 2)))
+    return out
+
+
+def _energy(ob: dict[str, Any]) -> float:
+    return float(np.sum(ob["w"] * ob["c"] ** 2))
+
+
+def _merge_fragments(objects: list[dict[str, Any]], cell: float, range_cell: float
+                     ) -> list[dict[str, Any]]:
+    """Objects (strongest first) with each fragment joined to the stronger object it
+    lies within a resolution cell of (laterally ``cell``, in range half ``range_cell``)
+    when it is weaker than that object by more than :data:`FRAGMENT_DB`: within one
+    cell the sparse solution spreads an object over several voxels, and what the model
+    misses of a full-wave object (5-15 % in amplitude) lands there too; neither is
+    another object."""
+    kept: list[dict[str, Any]] = []
+    ratio = 10 ** (FRAGMENT_DB / 10)
+    for ob in objects:
+        cx, cy, cz = (float(np.average(ob[k], weights=ob["w"])) for k in ("x", "y", "z"))
+        host = None
+        for big in kept:
+            near = (np.hypot(big["x"] - cx, big["y"] - cy) <= cell) & \
+                (np.abs(big["z"] - cz) <= 0.5 * range_cell)
+            if near.any() and _energy(ob) < ratio * _energy(big):
+                host = big
+                break
+        if host is None:
+            kept.append(dict(ob))
+        else:
+            for k in ("w", "vals", "x", "y", "z", "c"):
+                host[k] = np.concatenate([host[k], ob[k]])
+    return kept
 
 
 def _row(ob: dict[str, Any], sigma: float, medium: Any, interval: Any,
