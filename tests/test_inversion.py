@@ -110,11 +110,13 @@ def test_the_least_squares_stop_at_the_noise():
     assert r.method == "invert:lsqr" and step["unit"].startswith("Born")
 
 
-@pytest.mark.parametrize("tilted", [False, True])
+@pytest.mark.parametrize("tilted", [False, pytest.param(True, marks=pytest.mark.slow)])
 def test_one_frequency_point_within_a_quarter_cell(tilted):
     # A point 10-12 cm deep in sand, one frequency: under a level array 50 cm above the
-    # sand (the adjoint's maximum lies 8 cm short), and under a 35-degree array (the
-    # adjoint's maximum 7 cm short along its line of sight).
+    # sand (the adjoint's maximum lies 9 cm short), and under a 35-degree array (the
+    # adjoint's maximum 7 cm short along its line of sight). The planes reach 10 cm past
+    # the point on either side: the brightest voxel is the reflectivity's, not an edge's
+    # (measured: 0 and 1 cm in range, 0.4 and 0.5 cm across).
     if tilted:
         sand = hr.Medium.half_space(0.30, 2.5 + 0.0125j)
         truth = np.array([0.0, 0.05, 0.42])
@@ -123,13 +125,13 @@ def test_one_frequency_point_within_a_quarter_cell(tilted):
         src, size = hr.PlaneWave(polarization=(1, 0, 0)), 0.30
         grid = {"frame": "ground", "x": np.arange(-0.04, 0.0401, 0.005),
                 "y": np.arange(0.01, 0.0901, 0.005)}
-        zs = np.arange(0.36, 0.49, 0.01)
+        zs = np.arange(0.34, 0.55, 0.01)
     else:
         sand = hr.Medium.half_space(0.50, 2.5 + 0.0125j)
         truth = np.array([0.01, -0.005, 0.60])
         ap, src, size = _array(), hr.PlaneWave(polarization=Y), 0.40
         grid = {"upsample": 1}
-        zs = np.arange(0.54, 0.67, 0.01)
+        zs = np.arange(0.50, 0.71, 0.01)
     h = hr.simulate(hr.Scene(sand, src, [hr.PointTarget(tuple(truth))]), ap, F0,
                     include_surface=False, snr_db=30, seed=4)
     L = sand.apparent_distance(truth[2])

@@ -540,3 +540,22 @@ def test_find_objects_runs_detect_on_the_plane_shown(scene, tmp_path, monkeypatc
     page.s = page.s.replace(plane="mirror")
     page._find()
     assert "find objects: objects are found in the image plane" in page.status.text
+
+
+def test_reflectivity_display_is_invert_of_the_view(scene, tmp_path):
+    # display.plane = "reflectivity": the view's hologram inverted on the look's plane
+    # (hr.invert, least squares, the same options), refused for several views at once.
+    paths, _views, sand = scene
+    S = ViewSession(paths)
+    s = S.default_settings(ground=SAND).replace(depth=0.12, views=(1,), plane="reflectivity",
+                                                upsample=2)
+    got = S.image(s)
+    zs = 0.30 + np.linspace(0.0, 0.25, s.planes)     # the default sweep
+    ref = hr.invert(S.hologram(s, 1), zs, medium=sand, upsample=2, progress=False).plane(0.42)
+    np.testing.assert_allclose(got.data, ref.data, rtol=1e-12, atol=0)
+    assert got.method == "invert:lsqr"
+    with pytest.raises(ValueError, match="reflectivity inverts one view"):
+        S.image(s.replace(views=None))
+    toml = tmp_path / "look.toml"
+    toml.write_text(settings_toml(s, relative_to=tmp_path))
+    assert read_settings(toml).plane == "reflectivity"

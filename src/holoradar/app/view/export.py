@@ -87,7 +87,8 @@ def look_figure(session: ViewSession, s: ViewSettings) -> Any:
     ref = _reference(session, s, vol)
     surf = session.surface(s)
     lo, hi = (-s.db_range, 0.0) if s.scale == "db" else (0.0, 1.0)
-    label = "|E| (dB re sweep peak)" if s.scale == "db" else "|E| / sweep peak"
+    q = "|r|" if s.plane == "reflectivity" else "|E|"
+    label = f"{q} (dB re sweep peak)" if s.scale == "db" else f"{q} / sweep peak"
     fig = Figure(figsize=(13, 4.6), layout="constrained")
     axs = fig.subplots(1, 3, width_ratios=[1.1, 1, 1])
     plane = scaled(np.abs(img.data), ref, s.scale, s.db_range)
@@ -101,6 +102,8 @@ def look_figure(session: ViewSession, s: ViewSettings) -> Any:
         axs[0].set_title(f"mirror-source plane, range {float(img.z[0]) * CM:.1f} cm")
     else:
         word = "depth" if s.ground is not None else "range"
+        if s.plane == "reflectivity":
+            word = "reflectivity, " + word
         axs[0].set_title(f"{word} {(float(img.z[0]) - surf) * CM:.1f} cm; peak "
                          f"({pk.x * CM:.1f}, {pk.y * CM:.1f}) cm, {pk.level_db:.1f} dB")
     if session.kind != "survey":

@@ -391,7 +391,9 @@ class ViewSession:
             kw["fov"] = how.fov
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
-            if len(use) == 1:
+            if s.plane == "reflectivity":
+                img = self._reflectivity(use, z, medium, how)
+            elif len(use) == 1:
                 img = image_of(use[0], z, medium, how)
             elif how.combine == "incoherent" and use[0].is_wideband:
                 raise ValueError("views.frequency: the incoherent sum of frequencies is "
@@ -402,8 +404,24 @@ class ViewSession:
         return img, tuple(sorted({str(w.message) for w in said
                                   if not issubclass(w.category, AliasingWarning)}))
 
+    @staticmethod
+    def _reflectivity(use: list[Hologram], z: Any, medium: Any, how: Any) -> Image:
+        """One view's reflectivity (:func:`holoradar.invert`, damped least squares
+        stopped at the noise: the illumination divided out, each voxel's Born
+        amplitude) on the look's planes and pixels, the aperture's field of view."""
+        from ...imaging.inversion.api import invert
+
+        if len(use) != 1:
+            raise ValueError("display.plane: the reflectivity inverts one view's hologram; "
+                             "choose one view (views.use)")
+        kw: dict[str, Any] = {"upsample": how.upsample, "frame": how.frame}
+        if np.ndim(z) == 0:
+            return invert(use[0], float(z), medium=medium, progress=False, **kw)
+        return invert(use[0], z, medium=medium, progress=False, **kw)
+
     def _key(self, s: ViewSettings) -> tuple[Any, ...]:
-        return (self._glare_key(s), s.views, s.mode, s.upsample, s.fov, s.frame)
+        return (self._glare_key(s), s.views, s.mode, s.upsample, s.fov, s.frame,
+                s.plane == "reflectivity")
 
     def image(self, s: ViewSettings, depth: float | None = None) -> Image:
         """The plane shown for ``s`` (at ``depth``, default ``s.depth``), 2-D complex.
@@ -421,6 +439,10 @@ class ViewSession:
             return self._planes.get(("mosaic", d), lambda: mosaic(self.store, d))
         if s.plane == "mirror":
             return self.mirror_plane(s)
+        if s.plane == "reflectivity":
+            # A plane of the sweep's inversion: inverted alone, a plane would be made to
+            # explain what lies above and below it (one frequency's long focus).
+            return self.sweep(s).plane(self.surface(s) + d)
         z = self.surface(s) + d
         return self._planes.get((self._key(s), round(z, 12)), lambda: self._form(s, z))[0]
 

@@ -26,7 +26,8 @@ render`` turns one into the same image in batch. The TOML form::
     [display]
     scale = "db"          # or "linear"
     db_range = 30.0
-    plane = "image"       # or "mirror": the glare's mirror-source plane
+    plane = "image"       # or "mirror": the glare's mirror-source plane, or
+                          # "reflectivity": one view's inverted reflectivity (hr.invert)
     section = [0.0, 0.0]  # x, y (m) of the vertical sections; omitted: through the peak
 
     [ground]              # as holoradar's scene and medium files: surface, eps[, tan_delta]
@@ -45,10 +46,11 @@ from typing import Any
 
 from ...imaging.migration.settings import MigrationSettings, check_choice, check_upsample
 
-__all__ = ["GLARE_METHODS", "MODES", "ViewSettings", "read_settings", "settings_toml"]
+__all__ = ["GLARE_METHODS", "MODES", "PLANES", "ViewSettings", "read_settings", "settings_toml"]
 
 GLARE_METHODS = ("off", "gaussian", "image_source", "cut")
 MODES = ("coherent", "quasi-coherent", "amplitude")
+PLANES = ("image", "mirror", "reflectivity")
 _FREQ = ("coherent", "incoherent")
 
 
@@ -151,8 +153,8 @@ def _check(s: ViewSettings) -> None:
         _fail("display.scale", "'db' or 'linear'", s.scale)
     if not _finite(s.db_range) or not 1 <= s.db_range <= 200:
         _fail("display.db_range", "a number of dB from 1 to 200", s.db_range)
-    if s.plane not in ("image", "mirror"):
-        _fail("display.plane", "'image' or 'mirror'", s.plane)
+    if s.plane not in PLANES:
+        _fail("display.plane", "'image', 'mirror' or 'reflectivity'", s.plane)
     if s.section is not None and not (isinstance(s.section, tuple | list)
                                       and len(s.section) == 2
                                       and all(map(_finite, s.section))):

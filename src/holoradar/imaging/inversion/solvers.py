@@ -97,7 +97,8 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     """Column-normalised FISTA with the noise's threshold, then the kept voxels'
     least-squares refit (module docstring)."""
     import pylops
-    from pylops.optimization.sparsity import fista
+
+    from .fista import OnePairFISTA
 
     N, M = A.shape[1], d.size
     cf = c.ravel()
@@ -105,19 +106,21 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     eps = sigma * math.sqrt(math.log(N) + math.log(1 / false_alarm))
     # The step 1/L, L the largest eigenvalue of B^H B (power iterations).
     L = _largest_eigenvalue(B, progress)
-    bar = _bar(progress, max_iter, "invert (sparse)")
-    steps = [0]
-
-    def tick(_: np.ndarray) -> None:
-        steps[0] += 1
-        bar.update(1)
-
     first = float(np.abs(B.rmatvec(d)).max()) / L   # the size of the first step
+    # PyLops's FISTA soft-thresholds at eps * alpha / 2 (its objective is
+    # |d - B u|^2 + eps |u|_1): 2 eps for a threshold of eps on ``B^H d``.
+    solver = OnePairFISTA(B)
+    u = solver.setup(d, niter=max_iter, eps=2 * eps, alpha=1.0 / L, tol=TOL * first)
+    z = u.copy()
+    bar = _bar(progress, max_iter, "invert (sparse)")
+    iters = 0
     try:
-        # PyLops's FISTA soft-thresholds at eps * alpha / 2 (its objective is
-        # |d - B u|^2 + eps |u|_1): 2 eps for a threshold of eps on ``B^H d``.
-        u, iters, _ = fista(B, d, niter=max_iter, eps=2 * eps, alpha=1.0 / L,
-                            tol=TOL * first, callback=tick)
+        while iters < max_iter:
+            u, z, change = solver.step(u, z)
+            iters += 1
+            bar.update(1)
+            if change < TOL * first:
+                break
     finally:
         bar.close()
     support = np.abs(u) > 0

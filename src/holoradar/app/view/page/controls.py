@@ -13,7 +13,7 @@ import math
 from typing import Any
 
 from ..display import CM, distance
-from ..settings import GLARE_METHODS, MODES
+from ..settings import GLARE_METHODS, MODES, PLANES
 from .layout import CONTROLS_WIDTH
 
 __all__ = ["Controls"]
@@ -108,10 +108,10 @@ class Controls:
         self.db_range = Spinner(title="dB range", value=s.db_range, step=5, low=1, high=200,
                                 width=90, name="db_range")
         self.db_range.on_change("value", lambda _a, _o, n: self._set_db_range(n))
-        self.which = RadioButtonGroup(labels=["image plane", "mirror-source plane"],
-                                      active=0 if s.plane == "image" else 1, name="plane")
-        self.which.on_change("active", lambda _a, _o, n: self._set(
-            plane="image" if n == 0 else "mirror"))
+        self.which = RadioButtonGroup(
+            labels=["image plane", "mirror-source plane", "reflectivity"],
+            active=PLANES.index(s.plane), name="plane")
+        self.which.on_change("active", lambda _a, _o, n: self._set(plane=PLANES[n]))
 
     def _build_glare(self) -> None:
         """The glare suppression, the direct wave's, and the report of what they removed."""

@@ -235,6 +235,7 @@ class Figures:
         if s.scale == "db":
             self.mapper.low, self.mapper.high = -s.db_range, 0.0
             self.bar.title = ("|E| (dB re the unsuppressed glare)" if s.plane == "mirror"
+                              else "|r| (dB re sweep peak)" if s.plane == "reflectivity"
                               else "|E| (dB re sweep peak)")
         else:
             self.mapper.low, self.mapper.high = 0.0, 1.0

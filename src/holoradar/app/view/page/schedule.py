@@ -72,6 +72,8 @@ class Scheduling:
         S, s = self.session, self.s
         self.volume = S.sweep(s)
         self.fig.title.text = ("mirror-source plane (the glare's focus)" if s.plane == "mirror"
+                               else "reflectivity (inverted) at the slider's depth"
+                               if s.plane == "reflectivity"
                                else "plan view at the slider's depth")
         self.ref = float(np.abs(self.volume.data).max()) or 1.0
         if s.plane == "mirror":
