@@ -156,3 +156,18 @@ def test_bad_input_is_refused_with_its_name():
         hr.invert(h, 0.3, max_iter=0)
     with pytest.raises(ValueError, match="one frame"):
         hr.invert(h.with_data(np.stack([h.data, h.data])), 0.3)
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_any_work(monkeypatch):
+    # The solver's vectors are counted against the memory available before a step: the
+    # refusal names the grid's size and the ways out.
+    from holoradar.imaging.inversion import api
+
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))],
+                             source=hr.PlaneWave()), hr.Aperture.grid(8, 0.01), F0)
+    monkeypatch.setattr(api, "available_memory", lambda: 1 << 16)
+    calls = []
+    monkeypatch.setattr(api, "column_norms", lambda *a, **k: calls.append(1))
+    with pytest.raises(MemoryError, match=r"voxels needs about .* GiB.*fewer planes"):
+        hr.invert(h, np.linspace(0.2, 0.4, 30), upsample=4)
+    assert not calls

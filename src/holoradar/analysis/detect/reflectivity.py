@@ -17,8 +17,9 @@ reflectivity, not off the adjoint image's amplitude:
   over two cells) or a point;
 * a point under a level array is refined by the exact point response fitted to the
   hologram (:class:`~.model.HologramModel`: no grid, the Cramer-Rao standard
-  deviations); elsewhere its position's standard deviation is that of a peak of the
-  resolution cell's width at the object's SNR, ``cell sqrt(3 / (2 SNR)) / pi``;
+  deviations, the fitted amplitude); elsewhere its position's standard deviation is
+  that of a peak of the resolution cell's width at the object's SNR,
+  ``cell sqrt(3 / (2 SNR)) / pi``;
 * the amplitude is the object's Born amplitude, ``|sum_j r_j|``; its SNR
   ``sum |r_j c_j|^2 / sigma^2`` (the matched filter's).
 
@@ -343,6 +344,9 @@ def _refine_points(rows: list[dict[str, Any]], model: Any, medium: Any,
     for row, ob, std in zip(points, model.objects, model.uncertainty(), strict=True):
         row["x"], row["y"], row["range"] = (float(v) for v in ob["r"])
         row["x_std"], row["y_std"], row["range_std"] = (float(v) for v in std)
+        # The fitted point's amplitude (the band's mean magnitude): one number, where
+        # the voxels' sum at one frequency cancels along the long focus.
+        row["amplitude_db"] = 20 * math.log10(max(float(np.mean(np.abs(ob["a"]))), 1e-300))
         if medium is not None and medium.z_interfaces:
             row["depth"] = row["range"] - float(medium.z_interfaces[0])
             eps = float(np.real(medium.eps[int(medium.region_of(row["range"]))]))
