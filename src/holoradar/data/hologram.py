@@ -319,41 +319,26 @@ class Image:
         """``|data|^2``."""
         return np.abs(self.data) ** 2
 
-    def peak(self, unbiased: bool = False, *, hologram: Any = None, medium: Any = None,
-             migrate_options: Any = None) -> tuple[float, float, float]:
-        """``(x, y, z)`` of the brightest voxel over all planes, metres; with
-        ``unbiased=True``, of the brightest object.
+    def peak(self, unbiased: bool = False, **fit: Any) -> tuple[float, float, float]:
+        """``(x, y, z)`` of the brightest voxel over all planes, metres.
 
         The brightest voxel is not where the object is: along the line of sight the
         image's maximum is pulled towards the array (at one frequency by centimetres).
-        ``unbiased=True`` finds the object from the hologram the image came from
-        (:func:`holoradar.unbiased_peak`: the exact point response fitted to it under a
-        level array, the strongest object of the inverted reflectivity under a tilted
-        one), with its standard deviations.
+        The object's own position, from the hologram with its uncertainty (the exact
+        point fit under a level array, the inverted reflectivity's strongest object
+        under a tilted one), is :func:`holoradar.unbiased_peak`
+        ``(image, hologram, medium)``.
 
         Parameters
         ----------
         unbiased : bool
-            False: the brightest voxel. True: the object's position, which needs
-            ``hologram`` (and ``medium``, ``migrate_options`` as the image was made).
-        hologram : Hologram, optional
-            The hologram the image was migrated from (``unbiased=True`` only).
-        medium : Medium, optional
-            The ground the image was formed through (``unbiased=True`` only).
-        migrate_options : mapping, optional
-            ``migrate``'s other options the image was made with (``unbiased=True``).
+            Must be False: the fitted position is :func:`holoradar.unbiased_peak`
+            (a ``ValueError`` says so).
 
         Returns
         -------
         tuple of float
-            ``(x, y, z)``, metres (``unbiased=True``: a
-            :class:`~holoradar.analysis.detect.peak.PeakPosition` with ``.std``).
-
-        Raises
-        ------
-        ValueError
-            ``unbiased=True`` without ``hologram``; ``hologram``, ``medium`` or
-            ``migrate_options`` without ``unbiased=True``.
+            ``(x, y, z)``, metres.
 
         Examples
         --------
@@ -363,16 +348,10 @@ class Image:
         >>> img.peak()
         (3.0, 2.0, 0.2)
         """
-        if unbiased:
-            if hologram is None:
-                raise ValueError("Image.peak(unbiased=True) needs hologram= (the hologram "
-                                 "the image was migrated from): the object is found on it")
-            from ..analysis.detect.peak import unbiased_peak
-
-            return unbiased_peak(self, hologram, medium, migrate_options)
-        if hologram is not None or medium is not None or migrate_options is not None:
-            raise ValueError("hologram, medium and migrate_options go with unbiased=True "
-                             "(Image.peak() alone is the brightest voxel)")
+        if unbiased or fit:
+            raise ValueError("Image.peak() is the brightest voxel; the object's fitted "
+                             "position is holoradar.unbiased_peak(image, hologram, medium, "
+                             "migrate_options)")
         a = np.abs(self.data)
         if not self.has_z_axis:
             a = a[..., None, :, :]
