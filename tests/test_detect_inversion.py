@@ -90,3 +90,32 @@ def test_gprmax_rod_with_its_dipole_is_one_line():
     row = df.iloc[0]
     assert abs(row.x) < cell / 4 and abs(row.azimuth_deg - 90.0) < 2.0
     assert abs(row.depth - 0.10) < 0.01
+
+
+def test_two_layer_mat_under_the_papers_array_with_its_noise_is_four_bars():
+    # The paper's 16 x 16 array (2.5 cm: no evanescent band to estimate the noise from,
+    # so it is given), 8-12 GHz, 11 frequencies, 30 dB: two bars along x under 4 cm of
+    # concrete crossing two along y under 6 cm. Where they cross the sparse solution
+    # gives the crossing to the upper bar; the lower bars' pieces are joined again.
+    from test_detect_mat import CONCRETE as CONC
+    from test_detect_mat import POL, Z0, _mat
+
+    h = _mat(hr.Aperture.grid(16, 0.025, polarization=POL))
+    img = hr.migrate(h, np.arange(Z0 + 0.02, Z0 + 0.085, 0.005), medium=CONC, upsample=4)
+    sigma = np.sqrt(np.mean(np.abs(h.data) ** 2) / 10 ** 3)          # the 30 dB simulated
+    df = hr.detect(img, hologram=h, medium=CONC, eps_interval=(5.5, 6.5), noise=sigma)
+    assert list(df.kind) == ["line"] * 4, df[["kind", "x", "y", "depth", "length"]]
+    along_x = df[(df.azimuth_deg < 10) | (df.azimuth_deg > 170)]
+    along_y = df[(df.azimuth_deg - 90).abs() < 10]
+    cell = hr.theory.lateral_resolution(hr.C0 / 10e9, CONC.apparent_distance(Z0 + 0.05), 0.40)
+    assert sorted(along_x.y) == pytest.approx([-0.075, 0.075], abs=cell / 4)
+    assert sorted(along_y.x) == pytest.approx([-0.075, 0.075], abs=cell / 4)
+    assert df.spacing.to_numpy() == pytest.approx(0.15, rel=0.05)
+    for rows, cover in ((along_x, 0.04), (along_y, 0.06)):
+        assert (rows.depth_low <= cover).all() and (rows.depth_high >= cover).all(), rows
+
+
+def test_noise_without_the_hologram_is_refused(bars):
+    _, img = bars
+    with pytest.raises(ValueError, match=r"noise .* needs hologram="):
+        hr.detect(img, medium=CONCRETE, noise=1e-3)

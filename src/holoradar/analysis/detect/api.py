@@ -41,7 +41,7 @@ def _check(false_alarm: Any, kinds: Any, medium: Any, eps_interval: Any) -> tupl
 def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
            false_alarm: float = 1e-3, kinds: Sequence[str] = _KINDS,
            hologram: Any = None, migrate_options: Mapping[str, Any] | None = None,
-           max_objects: int = 100) -> Any:
+           max_objects: int = 100, noise: float | None = None) -> Any:
     """The objects in an image: what, where, how deep, how big, how sure.
 
     Parameters
@@ -64,16 +64,23 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         reflector or void: its outline polygon in ``df.attrs["outlines"]``, keyed
         by row).
     hologram : Hologram, optional
-        The hologram the image was migrated from (one frame, level aperture). With
-        it each object is the exact point response fitted to the hologram: its
-        position is the fit's (no pull towards the array), with a Cramer-Rao
-        standard deviation, and CLEAN subtracts its exact image. Without it, the
-        image's analytic point response (the spectral window) and its peak.
+        The hologram the image was migrated from (one frame; a tilted array's image in
+        the ground frame). With it the objects are read off the reflectivity inverted
+        from it on the image's planes (:func:`holoradar.invert`: the illumination
+        divided out, no sidelobes, no pull towards the array), and a point under a
+        level array is the exact point response fitted to the hologram, with its
+        Cramer-Rao standard deviations. Without it, CLEAN on the image with its own
+        point response (the spectral window) and its peak.
     migrate_options : mapping, optional
         Keyword arguments of ``migrate`` other than ``medium`` and ``upsample`` the
         image was made with (checked: the image must equal the hologram's migration).
     max_objects : int
-        CLEAN's limit.
+        The most objects reported (strongest first).
+    noise : float, optional
+        With ``hologram``: the receiver noise's standard deviation per sample, in the
+        hologram's units (default: estimated from its evanescent band, or, where its
+        pitch leaves none, assumed 40 dB below its power with a ``NoiseWarning``; a
+        noise set too low lets the inversion fit it, and spurious pieces follow).
 
     Returns
     -------
@@ -118,10 +125,14 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         from .reflectivity import detect_by_inversion
 
         rows, meta = detect_by_inversion(vol, hologram, medium, dict(migrate_options or {}),
+                                         noise,
                                          interval, fa, int(max_objects))
         return _frame([r for r in rows if r["kind"] in ks], meta, fa)
     if migrate_options:
         raise ValueError("migrate_options needs hologram=")
+    if noise is not None:
+        raise ValueError("noise is the hologram's receiver noise: it needs hologram= (the "
+                         "image alone sets its threshold from its own noise)")
     if vol.z.size > 1:
         if not _wideband(vol):
             raise ValueError("image: a volume at one frequency needs hologram= (its "

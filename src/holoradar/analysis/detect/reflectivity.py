@@ -19,7 +19,7 @@ reflectivity, not off the adjoint image's amplitude:
   hologram (:class:`~.model.HologramModel`: no grid, the Cramer-Rao standard
   deviations, the fitted amplitude); elsewhere its position's standard deviation is
   that of a peak of the resolution cell's width at the object's SNR,
-  ``cell sqrt(3 / (2 SNR)) / pi``;
+  ``cell sqrt(3 / (2 SNR)) / pi``, and the grid's ``pitch / sqrt(12)`` in quadrature;
 * the amplitude is the object's Born amplitude, ``|sum_j r_j|``; its SNR
   ``sum |r_j c_j|^2 / sigma^2`` (the matched filter's).
 
@@ -30,12 +30,14 @@ resolves, and its support is the object); beyond, damped least squares, threshol
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 
 from ..._lazy import lazy_module
 from ...data.hologram import C0
+from ...imaging.inversion.noise import NoiseWarning
 from .errors import HologramFitError
 from .grid import Volume
 from .table import depth_interval
@@ -58,8 +60,9 @@ DYNAMIC_RANGE_DB = -22.0
 
 
 def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any],
-                        interval: tuple[float, float] | None, false_alarm: float,
-                        max_objects: int) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+                        noise: float | None, interval: tuple[float, float] | None,
+                        false_alarm: float, max_objects: int
+                        ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Rows of ``detect``'s table and its attributes (see the module docstring)."""
     from ...imaging.inversion.api import reflectivity
 
@@ -87,9 +90,28 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         # The source unknown: its illumination taken as uniform (each object's amplitude
         # then carries it), said in the table's attributes.
         grid["illumination"] = "none"
-    res = reflectivity(hologram, zs, medium=medium, method=method, progress=False,
-                       max_iter=MAX_ITER if method == "sparse" else None,
-                       false_alarm=p, need_source=False, **grid)
+    def invert(sigma: float | None) -> Any:
+        return reflectivity(hologram, zs, medium=medium, method=method, progress=False,
+                            max_iter=MAX_ITER if method == "sparse" else None,
+                            false_alarm=p, need_source=False, noise=sigma, **grid)
+
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", NoiseWarning)
+        res = invert(noise)
+    assumed = [w for w in said if issubclass(w.category, NoiseWarning)]
+    if assumed:
+        # The noise could not be estimated and was assumed: what the first fit leaves
+        # of the data, noise and the model's error together, is a noise no lower than
+        # the true one; the inversion again with it (a noise set too low is fitted,
+        # and spurious pieces follow).
+        step = res.image.history[0]
+        sigma = max(res.sigma, step["residual"] / math.sqrt(hologram.data.size))
+        res = invert(sigma)
+        res.image.history[0]["noise"] = ("the residual of a first inversion with the "
+                                         "noise assumed 40 dB below the data's power")
+    for w in said:
+        if not issubclass(w.category, NoiseWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     r = res.image
     data = r.data if r.has_z_axis else r.data[None]
     c = res.column_norms.reshape(data.shape)
@@ -103,6 +125,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     objects = _merge_fragments(_objects(data, support, r, cell, hologram, medium, c), cell,
                                _range_cell(hologram, medium, float(np.median(vol.z))))
     objects = [ob for ob in objects if _energy(ob) > floor]
+    objects = _join_collinear(objects, cell, _range_cell(hologram, medium,
+                                                         float(np.median(vol.z))))
     if objects:
         top = max(float(ob["w"].max()) for ob in objects)
         objects = [ob for ob in objects
@@ -210,7 +234,8 @@ def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: 
             continue
         vals = data[iz, iy, ix]
         out.append({"w": np.abs(vals) ** 2, "vals": vals, "x": r.x[ix], "y": r.y[iy],
-                    "z": r.z[iz], "c": c[iz, iy, ix], "dx": dx})
+                    "z": r.z[iz], "c": c[iz, iy, ix], "dx": dx,
+                    "dz": dz if r.z.size > 1 else 0.0})
     out.sort(key=lambda ob: -_energy(ob))
     return out
 
@@ -246,6 +271,53 @@ def _merge_fragments(objects: list[dict[str, Any]], cell: float, range_cell: flo
     return kept
 
 
+def _axis(ob: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """An object's centroid (x, y, z), its unit axis, its length and width."""
+    w = ob["w"] / ob["w"].sum()
+    c = np.array([float(np.sum(w * ob[k])) for k in ("x", "y", "z")])
+    length, width, azimuth, _ = _extent(ob, w, c[0], c[1])
+    t = math.radians(azimuth)
+    return c, np.array([math.cos(t), math.sin(t)]), length, width
+
+
+def _join_collinear(objects: list[dict[str, Any]], cell: float, range_cell: float
+                    ) -> list[dict[str, Any]]:
+    """Pieces of one bar joined: two objects of which one is a line (longer than two
+    cells and three times its width) and the other lies on its axis (each centroid
+    within half a cell of the other's axis, directions within the angle a cell
+    subtends over the line, depths within half a range cell), the gap between them
+    along the axis shorter than the line. Where bars cross, the sparse solution gives
+    the crossing to the stronger bar, and the weaker one comes out in pieces."""
+    out = [dict(ob) for ob in objects]
+    joined = True
+    while joined:
+        joined = False
+        for i in range(len(out)):
+            ci, ui, li, wi = _axis(out[i])
+            if not (li > 2 * cell and li > 3 * wi):
+                continue
+            for j in range(len(out)):
+                if j == i:
+                    continue
+                cj, uj, lj, _ = _axis(out[j])
+                d = cj[:2] - ci[:2]
+                across = abs(d[0] * ui[1] - d[1] * ui[0])
+                along = abs(float(d @ ui))
+                turn = abs(float(ui @ uj)) if lj > 2 * cell else 1.0
+                if across <= 0.5 * cell and abs(cj[2] - ci[2]) <= 0.5 * range_cell and \
+                        turn >= math.cos(math.atan2(cell, li)) and \
+                        along - 0.5 * (li + lj) <= li:
+                    for k in ("w", "vals", "x", "y", "z", "c"):
+                        out[i][k] = np.concatenate([out[i][k], out[j][k]])
+                    del out[j]
+                    joined = True
+                    break
+            if joined:
+                break
+    out.sort(key=lambda ob: -_energy(ob))
+    return out
+
+
 def _row(ob: dict[str, Any], sigma: float, medium: Any, interval: Any,
          hologram: Any) -> dict[str, Any]:
     w = ob["w"] / ob["w"].sum()
@@ -257,8 +329,12 @@ def _row(ob: dict[str, Any], sigma: float, medium: Any, interval: Any,
     amp = abs(complex(np.sum(ob["vals"])))
     snr_lin = float(np.sum(ob["w"] * ob["c"] ** 2)) / sigma**2
     k = math.sqrt(3 / (2 * snr_lin)) if snr_lin > 0 else math.inf
-    std = (cell * k / math.pi, cell * k / math.pi,
-           _range_cell(hologram, medium, cz) * k / math.pi)
+    # The peak's spread at the object's SNR, and the grid's: a centroid of voxels a
+    # pitch p apart is off by up to p / 2, a standard deviation of p / sqrt(12).
+    grid = (ob["dx"] ** 2 / 12, ob["dx"] ** 2 / 12, ob.get("dz", 0.0) ** 2 / 12)
+    std = tuple(math.sqrt(s**2 + g) for s, g in zip(
+        (cell * k / math.pi, cell * k / math.pi,
+         _range_cell(hologram, medium, cz) * k / math.pi), grid, strict=True))
     depth = lo = hi = np.nan
     if medium is not None and medium.z_interfaces:
         depth = cz - float(medium.z_interfaces[0])
