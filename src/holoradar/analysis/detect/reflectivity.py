@@ -46,9 +46,9 @@ ndimage = lazy_module("scipy.ndimage")
 
 __all__ = ["SPARSE_VOXELS", "detect_by_inversion"]
 
-SPARSE_VOXELS = 3_000_000
-GRID_CELLS = 0.5
-MAX_ITER = 300
+SPARSE_VOXELS = 3_000_000   # voxel-frequencies up to which the sparse method is used
+GRID_CELLS = 0.5            # the inversion grid's pixel, in lateral resolution cells
+MAX_ITER = 300              # the sparse solver's steps in detect
 #: A weaker object within a resolution cell of a stronger one by more than this (the
 #: energy, dB) is a fragment of it: the aperture's first sidelobe level.
 FRAGMENT_DB = -13.3
@@ -90,6 +90,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         # The source unknown: its illumination taken as uniform (each object's amplitude
         # then carries it), said in the table's attributes.
         grid["illumination"] = "none"
+    rcell = _range_cell(hologram, medium, float(np.median(vol.z)))
+
     def invert(sigma: float | None) -> Any:
         return reflectivity(hologram, zs, medium=medium, method=method, progress=False,
                             max_iter=MAX_ITER if method == "sparse" else None,
@@ -123,10 +125,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     # where they stand above it.
     support = np.abs(data) > 0 if method == "sparse" else energy > res.threshold**2
     objects = _merge_fragments(_objects(data, support, r, cell, hologram, medium, c), cell,
-                               _range_cell(hologram, medium, float(np.median(vol.z))))
-    objects = [ob for ob in objects if _energy(ob) > floor]
-    objects = _join_collinear(objects, cell, _range_cell(hologram, medium,
-                                                         float(np.median(vol.z))))
+                               rcell)
+    objects = _join_collinear([ob for ob in objects if _energy(ob) > floor], cell, rcell)
     if objects:
         top = max(float(ob["w"].max()) for ob in objects)
         objects = [ob for ob in objects
@@ -137,8 +137,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         _refine_points(rows, model, medium, interval, hologram.nf > 1)
     _spacing(rows)
     meta = {"threshold": float(res.threshold), "noise_std": float(res.sigma),
-            "resolution_cell": [cell, cell, _range_cell(hologram, medium, float(np.median(vol.z)))
-                                    if hologram.nf > 1 else None], "n_cells": float(n_cells),
+            "resolution_cell": [cell, cell, rcell if hologram.nf > 1 else None],
+            "n_cells": float(n_cells),
             "model": f"reflectivity:{method}", "inversion": dict(step),
             "illumination": grid.get("illumination", "field"),
             "model_error_floor": float(floor)}
@@ -146,27 +146,26 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
 
 
 def _floor(threshold: float, residual: float, noise_norm: float) -> float:
-    """The energy ``|r_j c_j|^2`` a voxel needs to seed an object: above the noise's
-    threshold squared, and above what the fit leaves unexplained beyond the noise,
+    """The energy ``sum_j |r_j c_j|^2`` an object needs: above the noise's threshold
+    squared, and above what the fit leaves unexplained beyond the noise,
     ``|A r - d|^2 - M sigma^2`` (the model's error: the sparse fit explains part of it
-    by small spurious voxels, each weaker than what it leaves)."""
+    by small spurious objects, each weaker than what it leaves)."""
     return max(threshold**2, residual**2 - noise_norm**2)
 
 
 def _grid(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any]
           ) -> tuple[dict[str, Any], bool]:
-    """The inversion's grid: the image's planes; pixels of a quarter of the lateral
-    resolution cell at the shallowest plane (a point then lies within an eighth of a
-    cell of a voxel: the sparse solution keeps it in one or two voxels instead of
-    spreading it to fit the difference); a tilted array's ground frame, its region the
-    image's."""
-    quarter = GRID_CELLS * _lateral_cell(hologram, medium, float(np.min(vol.z)))
+    """The inversion's grid: the image's planes; pixels of at most :data:`GRID_CELLS`
+    of the lateral resolution cell at the shallowest plane (finer grids make nearly
+    parallel columns, which the sparse solver spreads a point over, and cost voxels);
+    a tilted array's ground frame, its region the image's."""
+    step_m = GRID_CELLS * _lateral_cell(hologram, medium, float(np.min(vol.z)))
     level = bool(hologram.pose.is_identity) and not vol.method.endswith(":ground") and \
         options.get("frame", "aperture") == "aperture"
     if level:
         pitch = max(hologram.pitch)
-        return {"upsample": max(1, min(8, math.ceil(pitch / quarter)))}, True
-    step = max(1, math.floor(quarter / vol.dx))
+        return {"upsample": max(1, min(8, math.ceil(pitch / step_m)))}, True
+    step = max(1, math.floor(step_m / vol.dx))
     return {"frame": "ground", "x": vol.x[::step], "y": vol.y[::step]}, False
 
 
