@@ -146,6 +146,11 @@ class MigrationOperator(LinearOperator):
         ``(nz, ny', nx')``, or ``(nf, nz, ny', nx')`` with ``combine="none"``.
     data_shape : tuple of int
         One frame's samples: ``(nf, ny, nx)`` for a band, ``(ny, nx)`` for one frequency.
+    oversampling : int
+        ``u``: the field is computed ``u`` times finer than the pitch and sampled at the
+        elements (``sampling="array"``; 1: on the hologram's own grid).
+    geometry : Hologram
+        The hologram's geometry (without its data).
     x, y : ndarray
         The image's pixel coordinates, metres.
     """
@@ -159,7 +164,7 @@ class MigrationOperator(LinearOperator):
         nz = plan.z.size
         self.image_shape = ((plan.nf,) if plan.separate else ()) + (nz, self.y.size,
                                                                     self.x.size)
-        self.data_shape = (plan.data_shape[:-2] + self.geometry.data.shape[-2:])
+        self.data_shape = plan.data_shape[:-2] + self.geometry.data.shape[-2:]
         super().__init__(dtype=plan.work, shape=(math.prod(self.data_shape),
                                                  math.prod(self.image_shape)))
 
