@@ -204,10 +204,6 @@ def _rows(result: CleanResult, vol: Volume, model: Any, medium: Any,
           interval: tuple[float, float] | None) -> list[dict[str, Any]]:
     stds: list[Any] = [c.std for c in result.components]
     positions = [c.position for c in result.components]
-    if getattr(model, "kind", "") == "hologram" and result.components:
-        model.refine()
-        positions = [tuple(float(v) for v in ob["r"]) for ob in model.objects]
-        stds = [tuple(float(v) for v in s) for s in model.uncertainty()]
     wideband = np.atleast_1d(vol.frequency).size > 1 if vol.frequency is not None else False
     rows = []
     for c, pos, std in zip(result.components, positions, stds, strict=True):

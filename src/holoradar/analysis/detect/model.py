@@ -1,22 +1,22 @@
 """The image of a point from the hologram: exact responses, fitted positions.
 
-With the hologram that made the image, each object is a point scatterer fitted
-to the hologram: its exact field at the elements ``g(r)`` (the layered Green's
-function times the source's incident field, :class:`~holoradar.imaging.
-point_response.PointResponse`, the model ``autofocus`` fits), its position ``r``
-the maximum of the normalised matched filter
+With the hologram that made the image, a point (found in the inverted
+reflectivity by ``detect``, or at the image's brightest pixel by
+``unbiased_peak``) is refined as a point scatterer fitted to the hologram: its
+exact field at the elements ``g(r)`` (the layered Green's function times the
+source's incident field, :class:`~holoradar.imaging.point_response.PointResponse`,
+the model ``autofocus`` fits), its position ``r`` the maximum of the normalised matched filter
 
     F(r) = |<h_res, g(r)>|^2 / (||g(r)||^2 ||h_res||^2)
 
 on the residual hologram ``h_res`` (the hologram less the objects found). Unlike
 the image's amplitude maximum, this is the maximum-likelihood position of one
 point in white noise: it has no pull towards the array (the adjoint's ``1/r``
-weighting and the long focus of one frequency do not enter). The object's image
-is ``migrate(a g)`` with the image's own settings: CLEAN subtracts the exact
-response, sidelobes and range smear included, and the residual image is the
-migration of ``h_res`` (migration is linear once its data-dependent settings,
-the frequency weights and the loss compensation's SNR, are fixed to the
-original hologram's).
+weighting and the long focus of one frequency do not enter). Each point fitted is
+subtracted from the residual hologram before the next, and all are refitted
+together at the end. The image is checked to be the hologram's migration on a
+few planes, with the migration frozen on the original hologram (its frequency
+weights and the loss compensation's SNR).
 
 Position uncertainty: the Cramer-Rao bound of the fit, ``Cov = J^-1`` with
 ``J = (2 |a|^2 / s^2) Re[D^H P D]``, ``D`` the derivatives of ``g`` along x, y, z,
@@ -57,7 +57,6 @@ deviation along every axis."""
 
 DIFF_STEP = 1e-5
 """Central-difference step of the point response's derivatives, metres."""
-"""Planes of a volume on which the image is checked to be the hologram's migration."""
 
 
 class HologramModel:
@@ -74,8 +73,6 @@ class HologramModel:
     options : dict, optional
         Further keyword arguments the image was migrated with.
     """
-
-    kind = "hologram"
 
     def __init__(self, hologram: Hologram, volume: Volume, medium: Medium | None,
                  options: dict[str, Any] | None = None) -> None:
@@ -295,22 +292,14 @@ class HologramModel:
     def energy(h: np.ndarray) -> float:
         return float(np.vdot(h, h).real) or 1.0
 
-    def fit(self, R: np.ndarray, index: tuple[int, int, int],
-            peak: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
-        """Fit one object near the image peak, subtract it from the residual hologram.
-
-        Returns the object's image ``migrate(a g)``, its main lobe (the pixels of its
-        peak plane within 6 dB of its maximum) and ``{"position": ...}``.
-        """
-        cell = self._cell(peak[2])
-        r = self.fit_position(peak, self.res, cell)
+    def add_point(self, start: tuple[float, float, float]) -> np.ndarray:
+        """Fit one point from ``start`` (x, y, range; m) to the residual hologram, add it
+        to :attr:`objects` and subtract its response from the residual; its position."""
+        r = self.fit_position(start, self.res, self._cell(start[2]))
         _, a, g = self.focus(r, self.res)
-        m = a[:, None] * g
-        self.res = self.res - m
+        self.res = self.res - a[:, None] * g
         self.objects.append({"r": r, "a": a, "g": g})
-        img = self.image(m)
-        return img, self._lobe(img, index[0]), {"position": tuple(float(v) for v in r),
-                                                "object": len(self.objects) - 1}
+        return r
 
     def _cell(self, z: float) -> tuple[float, float]:
         """Lateral resolution lambda L / A at range z (the starting simplex's scale)."""
@@ -318,13 +307,6 @@ class HologramModel:
         L = self.pr_medium.apparent_distance(max(z, self.z_min))
         A, B = self.hologram.aperture_size
         return lam * L / A, lam * L / B
-
-    @staticmethod
-    def _lobe(img: np.ndarray, iz: int) -> np.ndarray:
-        a = np.abs(img)
-        jz = int(np.unravel_index(int(np.argmax(a)), a.shape)[0])
-        plane = a[jz] if abs(jz - iz) > 0 else a[iz]
-        return plane >= 0.5 * plane.max()
 
     # ------------------------------------------------------------ refinement
     def refine(self) -> None:

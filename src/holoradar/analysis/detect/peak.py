@@ -143,11 +143,11 @@ def unbiased_peak(image: Any, hologram: Any, medium: Any = None,
     index = tuple(int(i) for i in np.unravel_index(int(np.argmax(p)), p.shape))
     frac, _ = refine_peak(p, index)  # type: ignore[arg-type]
     start = vol.coords(*frac)
-    r = model.fit_position(start, model.res, model._cell(start[2]))
-    F, a, g = model.focus(r, model.res)
-    model.res = model.res - a[:, None] * g
-    model.objects.append({"r": r, "a": a, "g": g})
+    r = model.add_point(start)
+    a = model.objects[0]["a"]
     std = model.uncertainty()[0]
+    # The share of the hologram's energy the point explains: what it took out of it.
+    F = model.energy(model.h) - float(np.vdot(model.res, model.res).real)
     return PeakPosition(r, std, complex(a[0]), F / model.energy(model.h))
 
 

@@ -124,8 +124,7 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     # the data (the soft threshold then shrank them by it); least squares' are kept
     # where they stand above it.
     support = np.abs(data) > 0 if method == "sparse" else energy > res.threshold**2
-    objects = _merge_fragments(_objects(data, support, r, cell, hologram, medium, c), cell,
-                               rcell)
+    objects = _merge_fragments(_objects(data, support, r, cell, rcell, c), cell, rcell)
     objects = _join_collinear([ob for ob in objects if _energy(ob) > floor], cell, rcell)
     if objects:
         top = max(float(ob["w"].max()) for ob in objects)
@@ -187,8 +186,8 @@ def _range_cell(hologram: Any, medium: Any, z: float) -> float:
     return 4.97 * C0 / float(f[0]) * (L / max(min(hologram.aperture_size), 1e-9)) ** 2
 
 
-def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: Any,
-             medium: Any, c: np.ndarray) -> list[dict[str, Any]]:
+def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, rcell: float,
+             c: np.ndarray) -> list[dict[str, Any]]:
     """Voxels above the noise joined into objects, strongest first.
 
     Lateral neighbours touch (the grid's pixels are half a cell); in range, voxels
@@ -202,7 +201,6 @@ def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, hologram: 
         return []
     dx = float(abs(r.x[1] - r.x[0])) if r.x.size > 1 else cell
     dz = float(np.min(np.diff(r.z))) if r.z.size > 1 else 1.0
-    rcell = _range_cell(hologram, medium, float(np.median(r.z)))
     zreach = max(1, math.floor(rcell / 2 / dz))
     energy = np.where(keep, (np.abs(data) * c) ** 2, 0.0)
 
@@ -410,11 +408,7 @@ def _refine_points(rows: list[dict[str, Any]], model: Any, medium: Any,
     standard deviations."""
     points = [r for r in rows if r["kind"] == "point"]
     for row in points:
-        start = (row["x"], row["y"], row["range"])
-        pos = model.fit_position(start, model.res, model._cell(start[2]))
-        _, a, g = model.focus(pos, model.res)
-        model.res = model.res - a[:, None] * g
-        model.objects.append({"r": pos, "a": a, "g": g})
+        model.add_point((row["x"], row["y"], row["range"]))
     model.refine()
     for row, ob, std in zip(points, model.objects, model.uncertainty(), strict=True):
         row["x"], row["y"], row["range"] = (float(v) for v in ob["r"])

@@ -18,9 +18,9 @@ from ...data import range_checks
 from ...data.range_checks import RangeError, array_of, scaled, warn_above_ground
 
 __all__ = ["Reporter", "array_of", "check_ground", "check_planes", "check_ranges", "depth_ranges",
-           "input_history", "layout_option", "medium_from_options", "medium_options",
-           "output_options", "read_hologram", "refuse_outside_planes", "scaled",
-           "warn_above_ground"]
+           "frame_option", "input_history", "layout_option", "medium_from_options",
+           "medium_options", "output_options", "read_hologram", "refuse_outside_planes",
+           "scaled", "warn_above_ground"]
 
 
 class Reporter:
@@ -79,6 +79,13 @@ def output_options(fn: Callable[..., Any]) -> Callable[..., Any]:
         return fn(*args, report=Reporter(as_json, quiet), **kwargs)
 
     return wrapper
+
+
+frame_option = click.option(
+    "--frame", type=click.Choice(["aperture", "ground"]), default="aperture", show_default=True,
+    help="Planes parallel to the array (aperture) or level planes in the ground's frame (for a "
+         "tilted array; --z is then the world range).")
+"""``--frame``: the imaging frame, shared by the commands that image or invert."""
 
 
 def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:

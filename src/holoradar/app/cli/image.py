@@ -14,6 +14,7 @@ from .common import (
     Reporter,
     check_planes,
     depth_ranges,
+    frame_option,
     input_history,
     layout_option,
     medium_from_options,
@@ -60,10 +61,7 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
 @medium_options
 @click.option("--method", type=click.Choice(["angular", "fresnel"]), default="angular",
               show_default=True, help="Exact angular spectrum, or the paper's Fresnel kernel.")
-@click.option("--frame", type=click.Choice(["aperture", "ground"]), default="aperture",
-              show_default=True,
-              help="Planes parallel to the array (aperture) or level planes in the ground's "
-                   "frame (for a tilted array; --z is then the world range).")
+@frame_option
 @click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32),
               help="Image pixels per element pitch.")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),

@@ -13,6 +13,7 @@ from .common import (
     Reporter,
     check_planes,
     depth_ranges,
+    frame_option,
     input_history,
     layout_option,
     medium_from_options,
@@ -40,10 +41,7 @@ __all__ = ["COMMANDS"]
                    "(default: estimated from the hologram, or 40 dB below its power).")
 @click.option("--max-iter", type=click.IntRange(1, 100000), default=None,
               help="The most solver steps (default 100 lsqr, 1000 sparse).")
-@click.option("--frame", type=click.Choice(["aperture", "ground"]), default="aperture",
-              show_default=True,
-              help="Planes parallel to the array (aperture) or level planes in the ground's "
-                   "frame (for a tilted array; --z is then the world range).")
+@frame_option
 @click.option("--upsample", default=1, show_default=True, type=click.IntRange(1, 8),
               help="Voxels per element pitch.")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),

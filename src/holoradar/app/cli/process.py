@@ -16,6 +16,7 @@ from .common import (
     check_ground,
     check_planes,
     depth_ranges,
+    frame_option,
     input_history,
     layout_option,
     medium_from_options,
@@ -139,8 +140,7 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
               default="coherent", show_default=True,
               help="How the views add: complex sum with each view's incident phase removed, "
                    "phase-aligned sum, or sum of amplitudes.")
-@click.option("--frame", type=click.Choice(["aperture", "ground"]), default="aperture",
-              show_default=True, help="As for holoradar image.")
+@frame_option
 @click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32))
 @click.option("--horn", "horns", multiple=True, help=_SOURCE_HELP)
 @click.option("--plane-wave", "plane_waves", multiple=True, metavar="ALPHA,BETA",

@@ -414,10 +414,8 @@ class ViewSession:
         if len(use) != 1:
             raise ValueError("display.plane: the reflectivity inverts one view's hologram; "
                              "choose one view (views.use)")
-        kw: dict[str, Any] = {"upsample": how.upsample, "frame": how.frame}
-        if np.ndim(z) == 0:
-            return invert(use[0], float(z), medium=medium, progress=False, **kw)
-        return invert(use[0], z, medium=medium, progress=False, **kw)
+        return invert(use[0], z, medium=medium, progress=False, upsample=how.upsample,
+                      frame=how.frame)
 
     def _key(self, s: ViewSettings) -> tuple[Any, ...]:
         return (self._glare_key(s), s.views, s.mode, s.upsample, s.fov, s.frame,

@@ -23,7 +23,7 @@ from ..migration.memory import available_memory
 from ..migration.settings import MigrationSettings
 from .columns import column_norms
 from .noise import noise_std
-from .solvers import FALSE_ALARM, least_squares, sparse
+from .solvers import FALSE_ALARM, least_squares, noise_threshold, sparse
 
 __all__ = ["METHODS", "Reflectivity", "invert", "reflectivity"]
 
@@ -144,7 +144,7 @@ def reflectivity(hologram: Hologram, z: Any, *, medium: Any = None, method: str 
                   has_z_axis=np.ndim(z) != 0, history=(step,))
     n = c.size
     return Reflectivity(image, c, sigma,
-                        sigma * math.sqrt(math.log(n) + math.log(1 / false_alarm)))
+                        noise_threshold(sigma, n, false_alarm))
 
 
 def _check(hologram: Any, method: Any, max_iter: Any, need_source: bool = True) -> None:
@@ -181,7 +181,7 @@ def _options(hologram: Hologram, z: Any, given: dict[str, Any]) -> dict[str, Any
                                 wavelength=lam, z_max=zmax)
             opts["pad"] = max(3.0, *(m / n for m, n in zip(need, hologram.data.shape[-2:],
                                                            strict=True)))
-    MigrationSettings.of(**{k: v for k, v in opts.items()})   # the checks, once, here
+    MigrationSettings.of(**opts)   # the checks, once, here
     return opts
 
 

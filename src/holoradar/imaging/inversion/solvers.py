@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Solution", "least_squares", "sparse"]
+__all__ = ["Solution", "least_squares", "noise_threshold", "sparse"]
 
 FALSE_ALARM = 0.01   # the chance that noise alone leaves a voxel in the sparse solution
 TOL = 1e-5           # the sparse solver stops once a step changes the model by less than
@@ -103,7 +103,7 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     N, M = A.shape[1], d.size
     cf = c.ravel()
     B = pylops.aslinearoperator(A) * pylops.Diagonal((1.0 / cf).astype(A.dtype))
-    eps = sigma * math.sqrt(math.log(N) + math.log(1 / false_alarm))
+    eps = noise_threshold(sigma, N, false_alarm)
     # The step 1/L, L the largest eigenvalue of B^H B (power iterations).
     L = _largest_eigenvalue(B, progress)
     first = float(np.abs(B.rmatvec(d)).max()) / L   # the size of the first step
@@ -133,6 +133,18 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
             else f"max_iter ({max_iter}) steps")
     return Solution(r, int(iters), residual, sigma * math.sqrt(M), stop,
                     {"threshold": eps, "voxels_kept": int(support.sum())})
+
+
+def noise_threshold(sigma: float, n: int, false_alarm: float) -> float:
+    """``sigma sqrt(log n + log(1/p))``: what the largest of ``n`` correlations with pure
+    noise (each ``|.|^2 / sigma^2`` exponential) exceeds with probability ``p``.
+
+    Examples
+    --------
+    >>> round(noise_threshold(1.0, 1000, 0.01), 3)
+    3.393
+    """
+    return sigma * math.sqrt(math.log(n) + math.log(1 / false_alarm))
 
 
 def _largest_eigenvalue(B: Any, progress: Any, steps: int = 30) -> float:
