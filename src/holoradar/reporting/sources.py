@@ -227,10 +227,12 @@ def _image_objects(img: Any, name: str, medium: Any, args: dict[str, Any], req: 
     if req.z is not None:
         plane = _one_plane(req.z, planes, req, name)
         img = img.plane(plane) if img.has_z_axis else img
-    elif volume and detections is None:
-        raise ValueError(f"{name} is a volume of {planes.size} planes: give {n['hologram']} "
-                         f"(the hologram it was imaged from: objects fitted in 3-D) or {n['z']} "
-                         "(one plane, from the image alone)")
+    elif volume and detections is None and np.atleast_1d(img.frequency).size < 2:
+        # One frequency does not focus in range (the library refuses such a volume too);
+        # a wideband volume is searched plane by plane, as hr.detect does.
+        raise ValueError(f"{name} is a volume of {planes.size} planes at one frequency: give "
+                         f"{n['hologram']} (the hologram it was imaged from: objects found in "
+                         f"3-D) or {n['z']} (one plane, from the image alone)")
     if detections is not None:
         return img, detections
     return img, detect_quietly(img, medium=medium, **args)

@@ -7,9 +7,13 @@ reflectivity, not off the adjoint image's amplitude:
 
 * the voxels above the noise (``|r_j| c_j`` above the threshold that noise alone
   passes nowhere on the grid but with probability ``p``, ``c_j`` the operator's
-  column norm; the sparse inversion keeps only such voxels) are joined into objects
-  when they lie within half a resolution cell of each other laterally and within a
-  range cell in range (a bar's voxels, kept sparsely along it, make one object);
+  column norm; the sparse inversion keeps only such voxels) are joined into objects:
+  each voxel climbs its column's energy to its range peak, and peaks join where they
+  touch laterally and their ranges differ by at most half a range cell (a bar's
+  voxels, kept sparsely along it, make one object; bars crossing at depths further
+  apart than that stay two, where their voxels touch); the pieces of one bar (the
+  crossing goes to the stronger bar) are joined along its axis before anything is
+  judged on its energy;
 * each object's position is its voxels' centroid weighted by ``|r|^2``; its lateral
   extents along and across its principal axis (weighted second moments, the full
   width ``sqrt(12)`` standard deviations of a uniform bar, at least one voxel) make
@@ -49,6 +53,7 @@ __all__ = ["SPARSE_VOXELS", "detect_by_inversion"]
 SPARSE_VOXELS = 3_000_000   # voxel-frequencies up to which the sparse method is used
 GRID_CELLS = 0.5            # the inversion grid's pixel, in lateral resolution cells
 MAX_ITER = 300              # the sparse solver's steps in detect
+PROBE_ITER = 100            # its steps where the first fit only measures the noise
 #: A weaker object within a resolution cell of a stronger one by more than this (the
 #: energy, dB) is a fragment of it: the aperture's first sidelobe level.
 FRAGMENT_DB = -13.3
@@ -91,24 +96,33 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         # then carries it), said in the table's attributes.
         grid["illumination"] = "none"
     rcell = _range_cell(hologram, medium, float(np.median(vol.z)))
+    # Single precision: its relative 1e-7 lies far below any noise the threshold
+    # admits, and halves the memory each of the solver's hundreds of steps moves.
+    grid.setdefault("dtype", np.complex64)
 
-    def invert(sigma: float | None) -> Any:
+    def invert(sigma: float | None, steps: int) -> Any:
         return reflectivity(hologram, zs, medium=medium, method=method, progress=False,
-                            max_iter=MAX_ITER if method == "sparse" else None,
+                            max_iter=steps if method == "sparse" else None,
                             false_alarm=p, need_source=False, noise=sigma, **grid)
 
+    from ...imaging.inversion.noise import noise_std
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NoiseWarning)
+        _, how = noise_std(hologram, float(np.min(vol.z)), noise)
+    assumed = how.startswith("assumed")
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always", NoiseWarning)
-        res = invert(noise)
-    assumed = [w for w in said if issubclass(w.category, NoiseWarning)]
+        res = invert(noise, PROBE_ITER if assumed else MAX_ITER)
     if assumed:
-        # The noise could not be estimated and was assumed: what the first fit leaves
-        # of the data, noise and the model's error together, is a noise no lower than
-        # the true one; the inversion again with it (a noise set too low is fitted,
-        # and spurious pieces follow).
+        # The noise could not be estimated and was assumed: what a first fit leaves of
+        # the data, noise and the model's error together, is a noise no lower than the
+        # true one (fewer steps leave more: the probe errs high, towards missing a weak
+        # object rather than reporting the noise's pieces); the inversion again with it
+        # (a noise set too low is fitted, and spurious pieces follow).
         step = res.image.history[0]
         sigma = max(res.sigma, step["residual"] / math.sqrt(hologram.data.size))
-        res = invert(sigma)
+        res = res.again(sigma) if method == "sparse" else invert(sigma, MAX_ITER)
         res.image.history[0]["noise"] = ("the residual of a first inversion with the "
                                          "noise assumed 40 dB below the data's power")
     for w in said:
@@ -124,8 +138,12 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     # the data (the soft threshold then shrank them by it); least squares' are kept
     # where they stand above it.
     support = np.abs(data) > 0 if method == "sparse" else energy > res.threshold**2
-    objects = _merge_fragments(_objects(data, support, r, cell, rcell, c), cell, rcell)
-    objects = _join_collinear([ob for ob in objects if _energy(ob) > floor], cell, rcell)
+    # A bar's pieces (where bars cross, the stronger takes the crossing) are joined
+    # first: a piece is weaker than the bar it crosses, the whole bar is not, and the
+    # floor holds for the whole bar, not for each piece.
+    objects = _join_collinear(_objects(data, support, r, cell, rcell, c), cell, rcell)
+    objects = _join_collinear(_merge_fragments(objects, cell, rcell), cell, rcell)
+    objects = [ob for ob in objects if _energy(ob) > floor]
     if objects:
         top = max(float(ob["w"].max()) for ob in objects)
         objects = [ob for ob in objects
@@ -205,9 +223,19 @@ def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, rcell: flo
     energy = np.where(keep, (np.abs(data) * c) ** 2, 0.0)
 
     def groups(mask: np.ndarray) -> tuple[np.ndarray, int]:
-        joined = ndimage.binary_dilation(mask, np.ones((2 * zreach + 1, 1, 1), bool))
+        # Each voxel climbs its column's energy to its range peak; peaks join laterally
+        # where their ranges lie within half a range cell, and every voxel goes with
+        # its peak. Bars crossing at two depths are then two objects where their
+        # range responses overlap, and a sloping object stays one.
+        top = _range_peaks(np.where(mask, energy, 0.0), mask)
+        peaks = mask & (top == np.arange(mask.shape[0])[:, None, None])
+        # Peaks whose planes differ by at most zreach join: each grown by half of it.
+        half = zreach // 2
+        joined = ndimage.binary_dilation(peaks, np.ones((2 * half + 1, 1, 1), bool)) \
+            if half else peaks
         labels, count = ndimage.label(joined, np.ones((3, 3, 3), bool))
-        return np.where(mask, labels, 0), count
+        iy, ix = np.indices(mask.shape[1:])
+        return np.where(mask, labels[top, iy, ix], 0), count
 
     group, count = groups(keep)
     peak = np.asarray(ndimage.maximum(energy, group, np.arange(count + 1)))
@@ -235,6 +263,30 @@ def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, rcell: flo
                     "dz": dz if r.z.size > 1 else 0.0})
     out.sort(key=lambda ob: -_energy(ob))
     return out
+
+
+def _range_peaks(energy: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """For each voxel of ``mask`` the plane of the range peak it climbs to along its
+    column (through neighbouring voxels of the mask, each step to the brighter
+    neighbour); elsewhere its own plane."""
+    nz = energy.shape[0]
+    here = np.broadcast_to(np.arange(nz)[:, None, None], energy.shape)
+    if nz == 1:
+        return np.array(here)
+    pad = np.pad(energy, ((1, 1), (0, 0), (0, 0)), constant_values=-1.0)
+    below, above = pad[:-2], pad[2:]
+    step = np.where((below > energy) & (below >= above), -1,
+                    np.where(above > energy, 1, 0))
+    step = np.where(mask, step, 0)
+    iy, ix = np.indices(energy.shape[1:])
+    top = np.array(here + step)
+    # Pointer jumping: each pass doubles the steps followed.
+    for _ in range(max(1, math.ceil(math.log2(nz))) + 1):
+        nxt = top[top, iy, ix]
+        if np.array_equal(nxt, top):
+            break
+        top = nxt
+    return top
 
 
 def _energy(ob: dict[str, Any]) -> float:
@@ -286,27 +338,30 @@ def _join_collinear(objects: list[dict[str, Any]], cell: float, range_cell: floa
     along the axis shorter than the line. Where bars cross, the sparse solution gives
     the crossing to the stronger bar, and the weaker one comes out in pieces."""
     out = [dict(ob) for ob in objects]
+    axes = [_axis(ob) for ob in out]
     joined = True
     while joined:
         joined = False
         for i in range(len(out)):
-            ci, ui, li, wi = _axis(out[i])
+            ci, ui, li, wi = axes[i]
             if not (li > 2 * cell and li > 3 * wi):
                 continue
             for j in range(len(out)):
                 if j == i:
                     continue
-                cj, uj, lj, _ = _axis(out[j])
+                cj, uj, lj, _ = axes[j]
                 d = cj[:2] - ci[:2]
                 across = abs(d[0] * ui[1] - d[1] * ui[0])
                 along = abs(float(d @ ui))
+                # A piece's direction is known to about a cell over its length.
                 turn = abs(float(ui @ uj)) if lj > 2 * cell else 1.0
                 if across <= 0.5 * cell and abs(cj[2] - ci[2]) <= 0.5 * range_cell and \
-                        turn >= math.cos(math.atan2(cell, li)) and \
+                        turn >= math.cos(math.atan2(cell, min(li, lj))) and \
                         along - 0.5 * (li + lj) <= li:
                     for k in ("w", "vals", "x", "y", "z", "c"):
                         out[i][k] = np.concatenate([out[i][k], out[j][k]])
-                    del out[j]
+                    del out[j], axes[j]
+                    axes[i if i < j else i - 1] = _axis(out[i if i < j else i - 1])
                     joined = True
                     break
             if joined:

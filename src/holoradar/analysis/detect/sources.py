@@ -190,7 +190,7 @@ def from_image(img: Any, medium: Any, args: Mapping[str, Any], *, hologram: Any 
     ------
     DetectionInputError
         Both ``hologram`` and ``plane``, or a plane outside the image's (``"z"``); a
-        volume with neither (``"source"``).
+        volume at one frequency with neither (``"source"``).
     ValueError
         A hologram that did not make the image (:func:`fit`, as ``--hologram``).
     """
@@ -203,11 +203,15 @@ def from_image(img: Any, medium: Any, args: Mapping[str, Any], *, hologram: Any 
     if plane is not None:
         refuse_outside(plane, planes, f"{name}'s planes")
         img = img.plane(plane)
-    elif bool(img.has_z_axis) and planes.size > 1:
+    elif bool(img.has_z_axis) and planes.size > 1 and np.atleast_1d(img.frequency).size < 2:
+        # One frequency does not focus in range: the library refuses such a volume too.
         raise DetectionInputError(
-            f"{name} is a volume of {planes.size} planes: give --hologram HOLO.nc (the "
-            "hologram it was imaged from: objects fitted in 3-D) or --z RANGE (one plane, "
-            "from the image alone)", "source")
+            f"{name} is a volume of {planes.size} planes at one frequency (its range focus "
+            "is tens of centimetres long): give --hologram HOLO.nc (the hologram it was "
+            "imaged from: objects found in 3-D) or --z RANGE (one plane, from the image "
+            "alone)", "source")
+    # A wideband volume is searched as the library searches it: plane by plane, each
+    # object's range from its range profile.
     return detect_quietly(img, medium=medium, **args)
 
 

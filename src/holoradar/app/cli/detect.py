@@ -2,10 +2,11 @@
 
 FILE is one of
 
-* an image file (what ``holoradar image`` or ``holoradar mosaic`` writes): a plane
-  is searched as it is; a volume needs ``--hologram`` (the hologram it was imaged
-  from: each object is the point response fitted to it, unbiased in range) or
-  ``--z`` (one plane of it, from the image alone);
+* an image file (what ``holoradar image`` or ``holoradar mosaic`` writes): with
+  ``--hologram`` (the hologram it was imaged from) the objects are read off the
+  reflectivity inverted from it; without, a plane is searched as it is, a wideband
+  volume plane by plane (as ``hr.detect`` does), and a one-frequency volume needs
+  ``--z`` (one plane of it);
 * a hologram file: imaged first on the planes ``--z`` (required) through the ground
   flags, four pixels per pitch, then searched with the hologram's fit;
 * a survey store (``.zarr`` from ``holoradar batch``): each frame searched with its
@@ -283,7 +284,11 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
                       "columns": [str(c) for c in df.columns], "units": "m, dB, deg"})
     if out is not None:
         write(out, df, metadata, frame)
-    lines = table_lines(df) if len(df) else ["no object above the threshold"]
+    none = "no object above the threshold"
+    if info.get("input") == "image" and "hologram" not in info:
+        none += (" (from the image alone: --hologram, the file it was imaged from, reads "
+                 "the objects off the reflectivity inverted from it)")
+    lines = table_lines(df) if len(df) else [none]
     counts = ", ".join(f"{int((df['kind'] == k).sum())} {k}(s)" for k in _KINDS
                        if (df["kind"] == k).any()) or "none"
     head = f"{file.name}: {len(df)} object(s) ({counts}), false alarm {args['false_alarm']:g} " \

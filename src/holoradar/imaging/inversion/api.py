@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -108,6 +108,10 @@ class Reflectivity:
     column_norms: np.ndarray   # c_j, image_shape
     sigma: float               # the noise's standard deviation per sample
     threshold: float           # |r_j| c_j above it: not noise (the sparse threshold)
+    again: Any = field(default=None, repr=False, compare=False)
+    """``again(sigma)``: the same inversion with another noise, its operator, column
+    norms and step size kept (a noise revised after a first fit costs the steps, not
+    the set-up)."""
 
 
 def reflectivity(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsqr",
@@ -129,22 +133,26 @@ def reflectivity(hologram: Hologram, z: Any, *, medium: Any = None, method: str 
     sigma, how = noise_std(hologram, min(float(zs.min()), surface), noise)
     d = A.vector(hologram).astype(A.dtype, copy=False)
     c = column_norms(A, _cell_px(A, hologram))
-    if method == "lsqr":
-        sol = least_squares(A, d, sigma, c, steps, progress)
-    else:
-        sol = sparse(A, d, sigma, c, steps, progress, false_alarm)
-    out = A.to_image(sol.r)
-    step = {"name": "invert", "method": method, "noise_std": sigma, "noise": how,
-            "iterations": sol.iterations, "residual": sol.residual,
-            "noise_norm": sol.noise_norm, "residual_over_noise": sol.residual / sol.noise_norm,
-            "stop": sol.stop, "unit": "Born scattering amplitude per voxel",
-            **{k: float(v) for k, v in sol.extra.items()}}
-    data = out.data if np.ndim(z) != 0 else out.data[..., 0, :, :]
-    image = Image(data, out.x, out.y, zs, out.frequency, f"invert:{method}",
-                  has_z_axis=np.ndim(z) != 0, history=(step,))
-    n = c.size
-    return Reflectivity(image, c, sigma,
-                        noise_threshold(sigma, n, false_alarm))
+
+    def solve(sigma: float, how: str, warm: Any = None) -> Reflectivity:
+        if method == "lsqr":
+            sol = least_squares(A, d, sigma, c, steps, progress)
+        else:
+            sol = sparse(A, d, sigma, c, steps, progress, false_alarm, warm=warm)
+        out = A.to_image(sol.r)
+        step = {"name": "invert", "method": method, "noise_std": sigma, "noise": how,
+                "iterations": sol.iterations, "residual": sol.residual,
+                "noise_norm": sol.noise_norm,
+                "residual_over_noise": sol.residual / sol.noise_norm,
+                "stop": sol.stop, "unit": "Born scattering amplitude per voxel",
+                **{k: float(v) for k, v in sol.extra.items()}}
+        data = out.data if np.ndim(z) != 0 else out.data[..., 0, :, :]
+        image = Image(data, out.x, out.y, zs, out.frequency, f"invert:{method}",
+                      has_z_axis=np.ndim(z) != 0, history=(step,))
+        return Reflectivity(image, c, sigma, noise_threshold(sigma, c.size, false_alarm),
+                            lambda s, h="given": solve(float(s), h, sol.warm))
+
+    return solve(sigma, how)
 
 
 def _check(hologram: Any, method: Any, max_iter: Any, need_source: bool = True) -> None:

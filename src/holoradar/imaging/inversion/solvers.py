@@ -52,6 +52,7 @@ class Solution:
     noise_norm: float     # sigma sqrt(M)
     stop: str
     extra: dict
+    warm: Any = None      # what a rerun with another noise keeps (sparse: its step)
 
 
 def _bar(progress: Any, total: int, desc: str) -> Any:
@@ -93,9 +94,13 @@ def least_squares(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: 
 
 
 def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
-           progress: Any = None, false_alarm: float = FALSE_ALARM) -> Solution:
+           progress: Any = None, false_alarm: float = FALSE_ALARM,
+           warm: Any = None) -> Solution:
     """Column-normalised FISTA with the noise's threshold, then the kept voxels'
-    least-squares refit (module docstring)."""
+    least-squares refit (module docstring). ``warm``: a previous solution's
+    ``Solution.warm`` on the same operator (its step size kept; a model to start from,
+    if it carries one: a start from a solution at another threshold changes where 300
+    steps end, so the rerun in ``detect`` starts from zero)."""
     import pylops
 
     from .fista import OnePairFISTA
@@ -105,12 +110,14 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     B = pylops.aslinearoperator(A) * pylops.Diagonal((1.0 / cf).astype(A.dtype))
     eps = noise_threshold(sigma, N, false_alarm)
     # The step 1/L, L the largest eigenvalue of B^H B (power iterations).
-    L = _largest_eigenvalue(B, progress)
-    first = float(np.abs(B.rmatvec(d)).max()) / L   # the size of the first step
+    L, first, u0 = warm if warm is not None else (_largest_eigenvalue(B, progress), None, None)
+    if first is None:
+        first = float(np.abs(B.rmatvec(d)).max()) / L   # the size of the first step
     # PyLops's FISTA soft-thresholds at eps * alpha / 2 (its objective is
     # |d - B u|^2 + eps |u|_1): 2 eps for a threshold of eps on ``B^H d``.
     solver = OnePairFISTA(B)
-    u = solver.setup(d, niter=max_iter, eps=2 * eps, alpha=1.0 / L, tol=TOL * first)
+    u = solver.setup(d, x0=u0, niter=max_iter, eps=2 * eps, alpha=1.0 / L,
+                     tol=TOL * first)
     z = u.copy()
     bar = _bar(progress, max_iter, "invert (sparse)")
     iters = 0
@@ -132,7 +139,7 @@ def sparse(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
     stop = (f"a step changed the model by less than {TOL:g} of the first" if iters < max_iter
             else f"max_iter ({max_iter}) steps")
     return Solution(r, int(iters), residual, sigma * math.sqrt(M), stop,
-                    {"threshold": eps, "voxels_kept": int(support.sum())})
+                    {"threshold": eps, "voxels_kept": int(support.sum())}, (L, first, None))
 
 
 def noise_threshold(sigma: float, n: int, false_alarm: float) -> float:
