@@ -4,19 +4,21 @@
 file, read again: each object fitted to it on all stored planes) or on one stored
 plane from the images alone; the objects are placed in survey coordinates from the
 frames' positions (:func:`to_survey`), each frame keeps those under its array, and
-an object seen by several overlapping frames is kept once, from the frame it lies
-nearest the centre of (:func:`merge`). ``holoradar detect STORE`` and the report's
+the rows of one object seen by several frames are joined into one
+(:func:`~holoradar.survey.merge.merge`: a line's extent the union of its frames',
+the frames it was seen in listed). ``holoradar detect STORE`` and the report's
 survey sections are this.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .merge import merge
 
 __all__ = ["from_store", "merge", "to_survey"]
 
@@ -179,22 +181,3 @@ def to_survey(df: Any, shift: tuple[float, float]) -> Any:
     df.attrs["outlines"] = {k: [[float(u) + dx, float(v) + dy] for u, v in ring]
                             for k, ring in df.attrs.get("outlines", {}).items()}
     return df
-
-
-def merge(df: Any) -> Any:
-    """One row per object: rows of one kind from different frames closer than a lateral
-    resolution cell (their ``_cell``) are one object, kept from the frame it lies nearest
-    the centre of (smallest ``_off``); sorted by amplitude, the helper columns dropped."""
-    if df.empty:
-        return df.drop(columns=["_off", "_cell"])
-    order = df.sort_values("_off", kind="stable").index
-    kept: list[int] = []
-    for i in order:
-        r = df.loc[i]
-        if not any(df.loc[j, "kind"] == r["kind"] and df.loc[j, "frame"] != r["frame"]
-                   and math.hypot(df.loc[j, "x"] - r["x"], df.loc[j, "y"] - r["y"])
-                   < max(r["_cell"], df.loc[j, "_cell"]) for j in kept):
-            kept.append(i)
-    out = df.loc[kept]
-    out = out.sort_values("amplitude_db", ascending=False, kind="stable")
-    return out.drop(columns=["_off", "_cell"]).reset_index(drop=True)
