@@ -79,17 +79,48 @@ def test_json_holds_the_records_and_the_metadata(files):
     assert meta["eps_interval"] is None and meta["false_alarm"] == 1e-3
 
 
-def test_geojson_is_a_feature_collection_in_local_metres(files):
+UTM33 = "EPSG:32633"
+
+
+def test_geojson_is_longitude_latitude_that_geopandas_reads_back(files):
+    # RFC 7946: WGS 84 longitude, latitude. geopandas reads the file as EPSG:4326 and,
+    # reprojected to the positions' CRS, every point lies where the table says (PROJ's
+    # round trip is exact to far below a millimetre; 1 cm is what a survey needs).
+    gpd = pytest.importorskip("geopandas")
     out = files["dir"] / "objects.geojson"
-    run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force", "-q")
+    run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force", "-q",
+        "--crs", UTM33)
     doc = json.loads(out.read_text())
     assert doc["type"] == "FeatureCollection" and "crs" not in doc
-    assert doc["coordinate_frame"]["units"] == "m"
+    assert doc["crs_of_properties"]["crs"].startswith("EPSG:32633")
     feats = doc["features"]
     assert [f["geometry"]["type"] for f in feats] == ["Point", "Point"]
     _same(_from_records([f["properties"] for f in feats])[files["ref"].columns], files["ref"])
-    for f, (_, row) in zip(feats, files["ref"].iterrows(), strict=True):
-        assert f["geometry"]["coordinates"] == pytest.approx([row.x, row.y], abs=1e-12)
+    g = gpd.read_file(out)
+    assert g.crs.to_epsg() == 4326
+    back = g.to_crs(UTM33)
+    np.testing.assert_allclose(back.geometry.x, files["ref"].x, rtol=0, atol=0.01)
+    np.testing.assert_allclose(back.geometry.y, files["ref"].y, rtol=0, atol=0.01)
+
+
+def test_geojson_of_a_known_point_is_its_longitude_and_latitude():
+    # UTM zone 33N's false origin: (500000 m, 0 m) is longitude 15 E on the equator.
+    df = pd.DataFrame([{"kind": "point", "x": 500000.0, "y": 0.0}])
+    (f,) = geojson(df, {}, "survey", UTM33)["features"]
+    assert f["geometry"]["coordinates"] == pytest.approx([15.0, 0.0], abs=1e-9)
+
+
+def test_geojson_without_a_crs_is_refused_with_the_way_out(files, tmp_path):
+    with pytest.raises(ValueError, match=r"--crs EPSG.*\.csv or \.json"):
+        geojson(pd.DataFrame([{"kind": "point", "x": 0.0, "y": 0.0}]), {}, "scene")
+    out = tmp_path / "o.geojson"
+    one_line_error(run("detect", files["img"], "--hologram", files["holo"], "-o", out,
+                       ok=False), "--out", "--crs", ".csv")
+    one_line_error(run("detect", files["img"], "--crs", "EPSG:99999", "-o", out, ok=False),
+                   "--crs", "EPSG:99999")
+    one_line_error(run("detect", files["img"], "--crs", "EPSG:4326", "-o", out, ok=False),
+                   "--crs", "projected")
+    assert not list(tmp_path.iterdir())
 
 
 def test_geojson_lines_and_areas():
@@ -98,12 +129,61 @@ def test_geojson_lines_and_areas():
          "y_end": 0.0, "length": 0.2, "width": 0.0, "azimuth_deg": 0.0},
         {"kind": "area", "x": 1.0, "y": 2.0, "x_start": np.nan, "y_start": np.nan,
          "x_end": np.nan, "y_end": np.nan, "length": 0.4, "width": 0.2, "azimuth_deg": 90.0}])
-    line, area = geojson(df, {}, "scene")["features"]
-    assert line["geometry"] == {"type": "LineString", "coordinates": [[-0.1, 0.0], [0.1, 0.0]]}
-    ring = np.array(area["geometry"]["coordinates"][0])
+    line, area = geojson(df, {}, "scene", UTM33)["features"]
+    assert line["geometry"]["type"] == "LineString"
+    ring = np.array(area["properties"]["outline_xy"])
     assert area["geometry"]["type"] == "Polygon" and np.allclose(ring[0], ring[-1])
     assert np.ptp(ring[:, 0]) == pytest.approx(0.2) and np.ptp(ring[:, 1]) == pytest.approx(0.4)
     assert area["properties"]["x_start"] is None    # NaN is null: valid JSON
+    lonlat = np.array(area["geometry"]["coordinates"][0])
+    assert lonlat.shape == ring.shape and np.allclose(lonlat[0], lonlat[-1])
+
+
+def test_a_table_of_several_kinds_is_one_geometry_type_per_file(tmp_path):
+    # A Shapefile layer holds one geometry type: OUT holds every object as its point,
+    # OUT_lines and OUT_points each kind's own geometry; each is written by pyogrio to
+    # a Shapefile without complaint.
+    gpd = pytest.importorskip("geopandas")
+    from holoradar.io.detections import write
+
+    df = pd.DataFrame([
+        {"kind": "line", "x": 0.0, "y": 0.0, "x_start": -0.1, "y_start": 0.0, "x_end": 0.1,
+         "y_end": 0.0, "length": 0.2, "azimuth_deg": 0.0},
+        {"kind": "point", "x": 0.3, "y": 0.1, "x_start": np.nan, "y_start": np.nan,
+         "x_end": np.nan, "y_end": np.nan, "length": 0.0, "azimuth_deg": np.nan}])
+    out = tmp_path / "o.geojson"
+    written = write(out, df, {}, "scene", UTM33)
+    assert [p.name for p in written] == ["o.geojson", "o_points.geojson", "o_lines.geojson"]
+    for p, types in zip(written, (["Point"], ["Point"], ["LineString"]), strict=True):
+        g = gpd.read_file(p)
+        assert list(g.geometry.geom_type.unique()) == types
+        g.to_file(tmp_path / f"{p.stem}.shp")
+
+
+def test_survey_with_a_crs_lands_where_its_object_is(tmp_path):
+    # Two frames placed in UTM 33N (easting, northing in metres) over one point 12 cm
+    # deep in sand; the store keeps the CRS (holoradar batch --crs): its GeoJSON,
+    # reprojected by geopandas, within 1 cm of the point (a quarter resolution cell is
+    # 8 mm here; the fit's standard deviation about 1 mm at 40 dB).
+    gpd = pytest.importorskip("geopandas")
+    e0, n0 = 500123.0, 4649776.0
+    scene = hr.Scene(SAND, hr.PlaneWave(), [hr.PointTarget((e0 + 0.04, n0 + 0.11, 0.42))])
+    paths = []
+    for i, x0 in enumerate((0.0, 0.1)):
+        ap = hr.Aperture.grid(16, 0.0125, pose=hr.Pose((e0 + x0, n0 + 0.1, 0.0)))
+        h = hr.simulate(scene, ap, 9.9e9, include_surface=False, snr_db=40, seed=i)
+        paths.append(hr.save(h, tmp_path / f"frame{i}.nc"))
+    run("batch", *paths, "-o", tmp_path / "s.zarr", "--z", "0.42", "--eps", "2.5+0.0125j",
+        "--z-surface", "0.3", "--upsample", "4", "--workers", "1", "--crs", UTM33, "-q")
+    out = tmp_path / "o.geojson"
+    run("detect", tmp_path / "s.zarr", "-o", out, "-q")
+    g = gpd.read_file(out).to_crs(UTM33)
+    assert len(g) == 1
+    assert abs(g.geometry.x[0] - (e0 + 0.04)) < 0.01 and abs(g.geometry.y[0] - (n0 + 0.11)) < 0.01
+    # A different CRS for the store is refused by name; nothing written.
+    one_line_error(run("detect", tmp_path / "s.zarr", "--crs", "EPSG:32632", "-o",
+                       tmp_path / "p.geojson", ok=False), "--crs", "32633")
+    assert not (tmp_path / "p.geojson").exists()
 
 
 def test_geojson_area_is_detects_outline(tmp_path):
@@ -115,24 +195,27 @@ def test_geojson_area_is_detects_outline(tmp_path):
                     9.9e9, include_surface=False, snr_db=30, seed=1)
     img = hr.save(hr.migrate(h, 0.40, medium=SAND, upsample=4), tmp_path / "plate.nc")
     out = tmp_path / "plate.geojson"
-    run("detect", img, *GROUND, "-o", out, "-q")
+    run("detect", img, *GROUND, "-o", out, "-q", "--crs", UTM33)
     ref = hr.detect(hr.load(img), medium=SAND)
     assert list(ref.kind) == ["area"]
     (feat,) = json.loads(out.read_text())["features"]
     assert feat["geometry"]["type"] == "Polygon"
-    ring = np.array(feat["geometry"]["coordinates"][0])
+    ring = np.array(feat["properties"]["outline_xy"])
     outline = np.array(ref.attrs["outlines"][0])
     assert ring.shape == outline.shape and np.allclose(ring[0], ring[-1])
     assert ring == pytest.approx(outline, abs=1e-12)
+    assert np.array(feat["geometry"]["coordinates"][0]).shape == ring.shape
 
 
 def test_geojson_closes_an_open_outline():
     df = pd.DataFrame([{"kind": "area", "x": 0.5, "y": 0.5, "length": 1.0, "width": 1.0,
                         "azimuth_deg": 0.0}])
     df.attrs["outlines"] = {0: [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]}
-    (area,) = geojson(df, {}, "scene")["features"]
-    assert area["geometry"]["coordinates"] == [[[0.0, 0.0], [1.0, 0.0], [0.5, 1.0],
-                                                [0.0, 0.0]]]
+    (area,) = geojson(df, {}, "scene", UTM33)["features"]
+    assert area["properties"]["outline_xy"] == [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0],
+                                                [0.0, 0.0]]
+    ring = area["geometry"]["coordinates"][0]
+    assert len(ring) == 4 and ring[0] == ring[-1]
 
 
 def test_hologram_file_imaged_on_z_then_fitted(files):
@@ -243,7 +326,7 @@ def test_survey_objects_in_survey_coordinates_once(survey, mode):
     d, z0 = survey["dir"], survey["z0"]
     plane = [] if mode == "hologram" else ["--z", f"{survey['plane']:g}"]
     out = d / f"objects_{mode}.geojson"
-    run("detect", d / "s.zarr", *plane, "-o", out, "--force")
+    run("detect", d / "s.zarr", *plane, "-o", out, "--force", "--crs", UTM33)
     doc = json.loads(out.read_text())
     feats = doc["features"]
     assert len(feats) == 1, [f["properties"] for f in feats]   # seen by both frames: once
@@ -251,7 +334,10 @@ def test_survey_objects_in_survey_coordinates_once(survey, mode):
     seen = hr.Medium.half_space(0.30 - z0, SAND.eps[1])
     cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, seen.apparent_distance(0.42 - z0), 0.2)
     assert abs(p["x"] - 0.04) < cell / 4 and abs(p["y"] - 0.11) < cell / 4
-    assert feats[0]["geometry"]["coordinates"] == pytest.approx([p["x"], p["y"]])
+    from holoradar.io.crs import as_crs, to_lonlat
+
+    assert feats[0]["geometry"]["coordinates"] == pytest.approx(
+        list(to_lonlat(p["x"], p["y"], as_crs(UTM33))), abs=1e-12)
     assert p["frame"] == "frame0.nc"       # the frame it lies nearest the centre of
     per_frame = doc["metadata"]["per_frame"]
     # One frequency: no finite range cell (null); the lateral cell bounds the depth.
@@ -259,7 +345,7 @@ def test_survey_objects_in_survey_coordinates_once(survey, mode):
     assert abs(p["depth"] - 0.12) < min(range_cell, cell) / 4, (p["depth"], cell)
     assert abs(p["range"] - (0.42 - z0)) < min(range_cell, cell) / 4
     assert p["depth"] == pytest.approx(0.12, abs=0.01)
-    assert "survey" in doc["coordinate_frame"]["frame"]
+    assert "survey" in doc["crs_of_properties"]["frame"]
     assert [f["frame"] for f in per_frame] == ["frame0.nc", "frame1.nc"]
     assert [f["array_z_m"] for f in per_frame] == pytest.approx([z0, z0])
 
@@ -278,14 +364,14 @@ def test_survey_geojson_area_is_the_frames_outline(tmp_path):
     hr.survey.run_batch([frame], store, z=[0.35], medium=SAND, upsample=4,
                         scheduler="synchronous")
     out = tmp_path / "plate.geojson"
-    run("detect", store, "--z", "0.35", "-o", out, "-q")
+    run("detect", store, "--z", "0.35", "-o", out, "-q", "--crs", UTM33)
     seen = hr.Medium.half_space(0.25, SAND.eps[1])
     ref = hr.detect(hr.survey.frame_image(store, 0).plane(0.35), medium=seen)
     assert list(ref.kind) == ["area"] and ref.depth[0] == pytest.approx(0.10, abs=0.01)
     (feat,) = json.loads(out.read_text())["features"]
     assert feat["geometry"]["type"] == "Polygon"
     assert feat["properties"]["depth"] == pytest.approx(ref.depth[0], abs=1e-12)
-    ring = np.array(feat["geometry"]["coordinates"][0])
+    ring = np.array(feat["properties"]["outline_xy"])
     assert ring == pytest.approx(np.array(ref.attrs["outlines"][0]), abs=1e-12)
     assert abs(ring[:, 0].mean() - 0.52) < 0.03 and abs(ring[:, 1].mean() - 0.19) < 0.03
 

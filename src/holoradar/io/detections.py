@@ -1,5 +1,6 @@
 """The objects' table written out: one line per object for the terminal, CSV, JSON
-(records and metadata) or GeoJSON (a FeatureCollection in local metres, for GIS).
+(records and metadata) or GeoJSON (RFC 7946: WGS 84 longitude and latitude, for GIS;
+needs the positions' coordinate reference system).
 
 The table is :func:`holoradar.detect`'s (a survey's also has ``frame``); what
 ``holoradar detect`` prints and writes with ``-o``.
@@ -16,7 +17,8 @@ import numpy as np
 
 from .plain import plain
 
-__all__ = ["SUFFIXES", "geojson", "medium_dict", "records", "table_lines", "write"]
+__all__ = ["SUFFIXES", "geojson", "geojson_files", "medium_dict", "records", "table_lines",
+           "write"]
 
 SUFFIXES = [".csv", ".json", ".geojson"]
 """The files :func:`write` writes, by suffix."""
@@ -27,36 +29,64 @@ def records(df: Any) -> list[dict[str, Any]]:
     return [{str(k): plain(v) for k, v in row.items()} for row in df.to_dict("records")]
 
 
-def geojson(df: Any, metadata: dict[str, Any], frame: str) -> dict[str, Any]:
-    """The objects as a GeoJSON FeatureCollection in a local metric frame.
+def geojson(df: Any, metadata: dict[str, Any], frame: str, crs: Any = None,
+            points_only: bool = False) -> dict[str, Any]:
+    """The objects as a GeoJSON FeatureCollection (RFC 7946: WGS 84 longitude, latitude).
 
     Points are ``Point``, lines ``LineString`` (their ends), areas ``Polygon``: the
     outline ``hr.detect`` found (``df.attrs["outlines"]``, keyed by row position, a
     closed ring), or without one the rectangle of their length, width and azimuth
-    about the centre; the properties are the table's row. Coordinates are ``(x, y)``
-    in metres in the scene's (or the survey's) frame, not longitude and latitude: the
-    top-level ``coordinate_frame`` member says so (RFC 7946 dropped the ``crs``
-    member).
+    about the centre; with ``points_only`` every object is the ``Point`` of its
+    position (one geometry type for a table of several kinds). The table's ``x``, ``y``
+    are easting and northing in metres in ``crs``; the geometry is transformed to
+    longitude and latitude (pyproj), the properties are the table's row (positions in
+    ``crs`` metres; an area's outline there as ``outline_xy``), and the top-level
+    ``crs_of_properties`` member names ``crs``.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        ``hr.detect``'s table, positions in ``crs``.
+    metadata : dict
+        Carried as the collection's ``metadata`` member.
+    frame : str
+        The positions' frame in words (a survey's, an image's axes).
+    crs : str or pyproj.CRS
+        The positions' projected coordinate reference system (metres).
+    points_only : bool
+        Every object as its position's ``Point``.
+
+    Raises
+    ------
+    ValueError
+        No ``crs`` (GeoJSON has no other coordinate system than longitude and
+        latitude), or one that is not a projected CRS in metres.
 
     Examples
     --------
     >>> import pandas as pd
-    >>> df = pd.DataFrame([{"kind": "point", "x": 0.1, "y": 0.2}])
-    >>> geojson(df, {}, "scene")["features"][0]["geometry"]
-    {'type': 'Point', 'coordinates': [0.1, 0.2]}
+    >>> df = pd.DataFrame([{"kind": "point", "x": 500000.0, "y": 0.0}])
+    >>> geojson(df, {}, "survey", "EPSG:32633")["features"][0]["geometry"]
+    {'type': 'Point', 'coordinates': [15.0, 0.0]}
     """
+    from .crs import as_crs, crs_name, to_lonlat
+
+    if crs is None:
+        raise ValueError("GeoJSON (RFC 7946) holds WGS 84 longitude and latitude, and the "
+                         "positions' coordinate reference system is not known: give it "
+                         "(--crs EPSG:..., the projected CRS of the frames' positions), or "
+                         "write .csv or .json (metres on the image's axes)")
+    crs = as_crs(crs)
     features = []
     outlines = df.attrs.get("outlines") or {}
     for n, row in enumerate(records(df)):
         kind = row.get("kind")
         ends = [row.get(k) for k in ("x_start", "y_start", "x_end", "y_end")]
-        if kind == "line" and all(v is not None for v in ends):
-            geom = {"type": "LineString", "coordinates": [ends[:2], ends[2:]]}
-        elif kind == "area" and outlines.get(n):
+        ring = None
+        if kind == "area" and outlines.get(n):
             ring = [[float(u), float(v)] for u, v in outlines[n]]
             if ring[0] != ring[-1]:
                 ring.append(list(ring[0]))
-            geom = {"type": "Polygon", "coordinates": [ring]}
         elif kind == "area":
             length, width = row.get("length") or 0.0, row.get("width") or 0.0
             az = math.radians(row.get("azimuth_deg") or 0.0)
@@ -64,33 +94,79 @@ def geojson(df: Any, metadata: dict[str, Any], frame: str) -> dict[str, Any]:
             v = (-math.sin(az) * width / 2, math.cos(az) * width / 2)
             ring = [[row["x"] + a * u[0] + b * v[0], row["y"] + a * u[1] + b * v[1]]
                     for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))]
-            geom = {"type": "Polygon", "coordinates": [ring]}
+        if ring is not None:
+            row["outline_xy"] = ring
+        if points_only:
+            kind_of, xy = "Point", [[row["x"], row["y"]]]
+        elif kind == "line" and all(v is not None for v in ends):
+            kind_of, xy = "LineString", [ends[:2], ends[2:]]
+        elif ring is not None:
+            kind_of, xy = "Polygon", ring
         else:
-            geom = {"type": "Point", "coordinates": [row["x"], row["y"]]}
+            kind_of, xy = "Point", [[row["x"], row["y"]]]
+        lon, lat = to_lonlat([p[0] for p in xy], [p[1] for p in xy], crs)
+        coords = [[float(a), float(b)] for a, b in zip(lon, lat, strict=True)]
+        geom = {"type": kind_of, "coordinates": coords[0] if kind_of == "Point" else
+                coords if kind_of == "LineString" else [coords]}
         features.append({"type": "Feature", "id": n + 1, "geometry": geom, "properties": row})
-    return {"type": "FeatureCollection",
-            "coordinate_frame": {
-                "type": "local", "units": "m", "axes": ["x", "y"], "frame": frame,
-                "note": "coordinates are metres in a local Cartesian frame (not longitude and "
-                        "latitude); depths and ranges are in the properties"},
+    return {"type": "FeatureCollection", "crs_of_properties": {
+                "crs": crs_name(crs), "frame": frame, "units": "m",
+                "note": "the geometry is WGS 84 longitude and latitude (RFC 7946); the "
+                        "properties' x, y (and line ends, outlines) are easting and northing "
+                        "in this CRS; depths and ranges are in the properties"},
             "metadata": metadata, "features": features}
 
 
-def write(out: Path, df: Any, metadata: dict[str, Any], frame: str) -> None:
+def geojson_files(out: Path, df: Any) -> dict[Path, Any]:
+    """The GeoJSON files ``-o OUT.geojson`` writes, one geometry type each: ``OUT`` alone
+    for a table of one kind; for several, ``OUT`` with every object as the point of its
+    position, and ``OUT_points``, ``OUT_lines``, ``OUT_areas`` (each kind's own
+    geometry). Values: the rows each holds (None: every row, as points)."""
+    kinds = [k for k in ("point", "line", "area") if len(df) and (df["kind"] == k).any()]
+    if len(kinds) <= 1:
+        return {out: df.index}
+    files: dict[Path, Any] = {out: None}
+    for k in kinds:
+        files[out.with_name(f"{out.stem}_{k}s{out.suffix}")] = df.index[df["kind"] == k]
+    return files
+
+
+def write(out: Path, df: Any, metadata: dict[str, Any], frame: str, crs: Any = None,
+          overwrite: bool = True) -> list[Path]:
     """Write the table to ``out`` in the format its suffix names (:data:`SUFFIXES`;
     anything else is JSON), atomically: ``metadata`` goes with JSON and GeoJSON,
-    ``frame`` (the coordinates' frame, in words) with GeoJSON."""
-    from .output import write_atomic
+    ``frame`` (the coordinates' frame, in words) and ``crs`` with GeoJSON, whose
+    table of several kinds is several files (:func:`geojson_files`; refused before
+    any is written where one exists and ``overwrite`` is False). Returns the files
+    written."""
+    from .output import check_output, write_atomic
 
     suffix = out.suffix.lower()
     if suffix == ".csv":
-        payload = df.to_csv(index=False).encode()
-    elif suffix == ".geojson":
-        payload = json.dumps(geojson(df, metadata, frame), indent=1, allow_nan=False).encode()
-    else:
-        payload = json.dumps({"metadata": metadata, "objects": records(df)}, indent=1,
-                             allow_nan=False).encode()
-    write_atomic(out, payload)
+        write_atomic(out, df.to_csv(index=False).encode())
+        return [out]
+    if suffix != ".geojson":
+        write_atomic(out, json.dumps({"metadata": metadata, "objects": records(df)},
+                                     indent=1, allow_nan=False).encode())
+        return [out]
+    files = geojson_files(out, df)
+    payloads = {}
+    for path, rows in files.items():
+        if path != out:
+            check_output(path, suffixes=[".geojson"], overwrite=overwrite, name="--out")
+        part = df if rows is None else df.loc[rows]
+        if rows is not None and part is not df:
+            outlines = df.attrs.get("outlines") or {}
+            pos = [df.index.get_loc(i) for i in rows]
+            part = part.reset_index(drop=True)
+            part.attrs = {**df.attrs, "outlines": {j: outlines[p] for j, p in enumerate(pos)
+                                                   if p in outlines}}
+        payloads[path] = json.dumps(geojson(part, metadata, frame, crs,
+                                            points_only=rows is None),
+                                    indent=1, allow_nan=False).encode()
+    for path, payload in payloads.items():
+        write_atomic(path, payload)
+    return list(payloads)
 
 
 def table_lines(df: Any) -> list[str]:

@@ -90,7 +90,8 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
               method: str = "angular", upsample: int = 1, workers: int | None = None,
               scheduler: str | None = None, strict: bool = False, overwrite: bool = False,
               retry_bad: bool = False, progress: bool = False, layout: Any = None,
-              on_start: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+              on_start: Callable[[dict[str, Any]], None] | None = None,
+              crs: Any = None) -> dict[str, Any]:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     Each frame (a hologram file written by :func:`holoradar.save`) is read with
@@ -149,6 +150,10 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     layout : Layout, dict or str, optional
         For frames in a user's format: where the hologram is in each file
         (:func:`holoradar.load`); the same for every frame.
+    crs : str or pyproj.CRS, optional
+        The projected coordinate reference system (metres: easting, northing) of the
+        frames' positions, kept with the store: GeoJSON of its objects is then WGS 84
+        longitude and latitude (``holoradar detect -o objects.geojson``).
     on_start : callable, optional
         Called once before the first frame is imaged (not when none is left to
         image) with the plan: ``frames`` (to image), ``bytes`` (the most the store
@@ -217,9 +222,17 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     """
     t0 = time.perf_counter()
     settings = Settings.make(z, medium, method, upsample)
+    if crs is not None:
+        from ..io.crs import as_crs
+
+        crs = as_crs(crs)
     sched, n_workers = where_asked(workers, scheduler)
     given = frame_paths(frames)
     target, exists = check_store(store, given)
+    if crs is not None and exists and not overwrite:
+        from .store import check_crs
+
+        check_crs(target, crs)
     # A cluster is reached before anything is written (an unreachable address is an error).
     client = schedule.connect(sched) if sched not in (*schedule.LOCAL, *OWN) else None
     try:
@@ -234,6 +247,10 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
     finally:
         if client is not None:
             client.close()
+    if crs is not None:
+        from .store import set_crs
+
+        set_crs(target, crs)
     summary["seconds"] = time.perf_counter() - t0
     return summary
 

@@ -571,3 +571,42 @@ def read_images(index: dict[str, Any], frames: Sequence[int],
     out.real = raw[..., 0]
     out.imag = raw[..., 1]
     return out
+
+
+def stored_crs(target: Path) -> Any:
+    """The coordinate reference system of a store's frame positions (a ``pyproj.CRS``),
+    or None where the survey was made without one."""
+    import zarr
+
+    text = zarr.open_group(str(target), mode="r").attrs.get("crs")
+    if not text:
+        return None
+    from ..io.crs import as_crs
+
+    return as_crs(text, "the store's crs")
+
+
+def check_crs(target: Path, crs: Any) -> None:
+    """Refuse a CRS other than the one a store's frames were placed in.
+
+    Raises
+    ------
+    ValueError
+        Named ``crs``.
+    """
+    from ..io.crs import crs_name
+
+    have = stored_crs(target)
+    if have is not None and not have.equals(crs):
+        raise ValueError(f"crs: the store's frame positions are in {crs_name(have)}, this "
+                         f"run gives {crs_name(crs)}: give the same, or a new store")
+
+
+def set_crs(target: Path, crs: Any) -> None:
+    """Keep ``crs`` (a ``pyproj.CRS``) with a store (its ``crs`` attribute, the CRS's
+    authority code or WKT)."""
+    import zarr
+
+    auth = crs.to_authority()
+    g = zarr.open_group(str(target), mode="r+")
+    g.attrs["crs"] = f"{auth[0]}:{auth[1]}" if auth else crs.to_wkt()

@@ -16,6 +16,7 @@ from .common import (
     array_of,
     check_ground,
     check_ranges,
+    crs_option,
     depth_ranges,
     medium_from_options,
     medium_options,
@@ -83,10 +84,12 @@ def _check_workers(ctx: click.Context, param: click.Parameter, value: str | None
 @click.option("--layout", default=None, metavar="KEY=VALUE,...",
               help="For frames in a user's format: where the hologram is in each file (see "
                    "holoradar image --help).")
+@crs_option
 @output_options
 def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any], method: str,
           upsample: int, workers: int | None, scheduler: str | None, strict: bool,
-          force: bool, retry_bad: bool, layout: str | None, report: Reporter) -> None:
+          force: bool, retry_bad: bool, layout: str | None, crs: Any,
+          report: Reporter) -> None:
     """Image every frame of a survey with the same settings into one Zarr store.
 
     FRAMES: hologram files or quoted patterns ('survey/*.nc'). A frame's position
@@ -126,7 +129,7 @@ def batch(frames: tuple[str, ...], out: Path, z: str, medium_spec: dict[str, Any
                       # A bar redraws its line with carriage returns: in a log file (stderr
                       # not a terminal) those are hundreds of lines of noise.
                       progress=report.progress and not report.as_json and sys.stderr.isatty(),
-                      layout=layout, on_start=started)
+                      layout=layout, on_start=started, crs=crs)
     except BatchInterrupted as exc:
         raise KeyboardInterrupt(f"{exc.stored} of {_frames(exc.frames)} "
                                 f"{'is' if exc.frames == 1 else 'are'} stored in {out}; "

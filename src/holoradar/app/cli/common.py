@@ -88,6 +88,26 @@ frame_option = click.option(
 """``--frame``: the imaging frame, shared by the commands that image or invert."""
 
 
+def _crs(ctx: Any, param: Any, value: str | None) -> Any:
+    from ...io.crs import as_crs
+
+    if value is None:
+        return None
+    try:
+        return as_crs(value, "--crs")
+    except ValueError as exc:
+        raise click.BadParameter(str(exc).removeprefix("--crs: "), param_hint="--crs") \
+            from None
+
+
+crs_option = click.option(
+    "--crs", default=None, metavar="EPSG:CODE", callback=_crs,
+    help="The projected coordinate reference system (metres: easting, northing) of the "
+         "positions, e.g. EPSG:32633 (UTM 33N): GeoJSON is then WGS 84 longitude and "
+         "latitude, as RFC 7946 requires.")
+"""``--crs``: the positions' coordinate reference system, read by pyproj."""
+
+
 def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
     """``--layout`` and ``--no-check`` for reading users' files."""
 

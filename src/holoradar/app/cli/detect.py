@@ -33,6 +33,7 @@ import numpy as np
 from .common import (
     Reporter,
     check_planes,
+    crs_option,
     depth_ranges,
     layout_option,
     medium_from_options,
@@ -230,14 +231,16 @@ def detection_options(f: Any) -> Any:
               help="An image FILE's hologram (the file it was imaged from): each object is "
                    "its point response fitted to it (unbiased position, with uncertainty).")
 @click.option("-o", "--out", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="The table: .csv, .json (records and metadata) or .geojson (a "
-                   "FeatureCollection in metres, for GIS).")
+              help="The table: .csv, .json (records and metadata) or .geojson (for GIS: "
+                   "WGS 84 longitude and latitude, needs the positions' CRS: --crs or a "
+                   "survey's own; a table of several kinds also as one file per kind).")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
+@crs_option
 @layout_option
 @output_options
 def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval: str | None,
            false_alarm: str, kinds: str, hologram: Path | None, out: Path | None, force: bool,
-           layout: str | None, check: bool, report: Reporter) -> None:
+           crs: Any, layout: str | None, check: bool, report: Reporter) -> None:
     """List the objects in an image, a hologram or a survey store.
 
     FILE: an image (holoradar image/mosaic), a hologram (imaged on --z first) or a
@@ -261,6 +264,7 @@ def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval:
     if store and hologram is not None:
         raise click.BadParameter("a survey store's frames are fitted with their own "
                                  "holograms: give no --hologram", param_hint="--hologram")
+    crs = _positions_crs(file, store, crs, out)
     if store:
         df, info, medium = _from_store(file, z, medium_spec, full, report)
         frame = "survey: x, y are world metres (the frames' positions plus pixel offsets)"
@@ -268,12 +272,37 @@ def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval:
         df, info, medium = _from_file(file, z, medium_spec, full, hologram, layout, check,
                                       report)
         frame = "scene: x, y are metres on the image's axes"
-    _done(file, df, info, medium, args, interval, out, frame, report)
+    _done(file, df, info, medium, args, interval, out, frame, report, crs, force)
+
+
+def _positions_crs(file: Path, store: bool, crs: Any, out: Path | None) -> Any:
+    """The positions' CRS: ``--crs`` or a survey store's own (they must agree); GeoJSON
+    without one is refused before any work."""
+    from ...io.crs import crs_name
+
+    if store:
+        from ...survey.store import stored_crs
+
+        have = stored_crs(file)
+        if have is not None and crs is not None and not have.equals(crs):
+            raise click.BadParameter(f"the store's frame positions are in {crs_name(have)}, "
+                                     f"not {crs_name(crs)}: give no --crs (or the same)",
+                                     param_hint="--crs")
+        crs = crs if crs is not None else have
+    if out is not None and out.suffix.lower() == ".geojson" and crs is None:
+        where = ("the survey's frame positions carry no coordinate reference system "
+                 "(holoradar batch --crs keeps one with the store)") if store else \
+            "the image's axes are metres in no known coordinate reference system"
+        raise click.BadParameter(f"GeoJSON (RFC 7946) is WGS 84 longitude and latitude, and "
+                                 f"{where}: give --crs EPSG:... (the projected CRS of the "
+                                 "positions), or write .csv or .json (metres)",
+                                 param_hint="--out")
+    return crs
 
 
 def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str, Any],
           interval: tuple[float, float] | None, out: Path | None, frame: str,
-          report: Reporter) -> None:
+          report: Reporter, crs: Any = None, force: bool = False) -> None:
     """The table on the terminal (or as JSON) and, with ``--out``, in its file."""
     from ...io.detections import medium_dict, records, table_lines, write
     from ...io.plain import plain
@@ -281,9 +310,15 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
     metadata = plain({"source": str(file), **info, "false_alarm": args["false_alarm"],
                       "kinds": list(args["kinds"]), "medium": medium_dict(medium),
                       "eps_interval": None if interval is None else list(interval),
-                      "columns": [str(c) for c in df.columns], "units": "m, dB, deg"})
+                      "columns": [str(c) for c in df.columns], "units": "m, dB, deg",
+                      "crs": None if crs is None else crs.to_string()})
+    written: list[Path] = []
     if out is not None:
-        write(out, df, metadata, frame)
+        try:
+            written = write(out, df, metadata, frame, crs, overwrite=force)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc).removeprefix("--out "),
+                                     param_hint="--out") from None
     none = "no object above the threshold"
     if info.get("input") == "image" and "hologram" not in info:
         none += (" (from the image alone: --hologram, the file it was imaged from, reads "
@@ -293,9 +328,10 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
                        if (df["kind"] == k).any()) or "none"
     head = f"{file.name}: {len(df)} object(s) ({counts}), false alarm {args['false_alarm']:g} " \
            "per resolution cell"
-    wrote = [f"wrote {out}"] if out is not None else []
+    wrote = [f"wrote {p}" for p in written]
     report.done({"objects": records(df), "n_objects": len(df), "metadata": metadata,
-                 "out": None if out is None else str(out)},
+                 "out": None if out is None else str(out),
+                 "files": [str(p) for p in written]},
                 [head, *lines, *wrote], result=[*lines, *wrote])
 
 

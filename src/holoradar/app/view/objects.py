@@ -72,12 +72,17 @@ def read_objects(path: str | Path) -> Any:
             else:
                 feats = doc["features"] if isinstance(doc, dict) else None
                 rows = None if not isinstance(feats, list) else \
-                    [dict(f["properties"]) for f in feats]
+                    [{k: v for k, v in f["properties"].items() if k != "outline_xy"}
+                     for f in feats]
                 for n, f in enumerate(feats or []):
+                    # The outline in the table's metres (the geometry is longitude and
+                    # latitude); a file of older versions has it in the geometry.
+                    props = f["properties"] or {}
                     g = f.get("geometry") or {}
-                    kind = (f["properties"] or {}).get("kind")
-                    if g.get("type") == "Polygon" and kind == "area":
-                        outlines[n] = [[float(u), float(v)] for u, v in g["coordinates"][0]]
+                    ring = props.get("outline_xy") if "crs_of_properties" in doc \
+                        else (g["coordinates"][0] if g.get("type") == "Polygon" else None)
+                    if ring and props.get("kind") == "area":
+                        outlines[n] = [[float(u), float(v)] for u, v in ring]
             if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
                 raise ValueError("no list of objects")
             df = pd.DataFrame(rows)
