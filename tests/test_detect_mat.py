@@ -174,6 +174,22 @@ def test_rebar_layers_groups_directions_across_0_and_180_degrees():
         rebar_layers([1, 2])
 
 
+def test_rebar_layers_split_one_direction_by_depth():
+    # A top and a bottom mat both along x, 4 and 10 cm deep: their depth intervals do not
+    # overlap, so they are two layers; bars of one layer whose intervals overlap stay one.
+    import pandas as pd
+
+    rows = [{"kind": "line", "x": 0.0, "y": y, "azimuth_deg": 0.0, "depth": d,
+             "depth_low": d - 0.004, "depth_high": d + 0.004}
+            for y, d in ((-0.15, 0.040), (0.0, 0.043), (0.15, 0.041), (-0.1, 0.10), (0.1, 0.10))]
+    t = rebar_layers(pd.DataFrame(rows))
+    assert t.bars.tolist() == [3, 2]
+    assert t.cover.tolist() == pytest.approx([0.041, 0.10])
+    assert (t.cover_min[0], t.cover_mean[0], t.cover_max[0]) == pytest.approx(
+        (0.040, 0.0413333, 0.043))
+    assert (t.spacing_mean[0], t.spacing[1]) == pytest.approx((0.15, 0.2))
+
+
 def test_an_area_seen_on_several_planes_is_one_area():
     # Each plane explains a disk by other components: the points and smaller areas
     # within a cell of the brightest area's outline are that area; a point two cells

@@ -10,7 +10,6 @@ documentation (``docs/figures/report_page.png`` comes from the slow demo below).
 
 from __future__ import annotations
 
-import math
 import os
 import shutil
 from pathlib import Path
@@ -20,7 +19,6 @@ import pytest
 
 import holoradar as hr
 from holoradar.app.view.browser import find_chromium, headless_chromium
-from holoradar.reporting.table import MISSING
 
 _, _, WHY = find_chromium()
 pytestmark = [pytest.mark.browser,
@@ -72,17 +70,9 @@ def _same_table(rows: list[dict], df) -> None:
     """The browser's rows against hr.detect's table: numbered from 1 in its order, each
     value exactly (the cell's data-value is the float's repr) and as shown (the value
     in the column's unit with the digits shown)."""
-    assert len(rows) == len(df)
-    for n, (row, rec) in enumerate(zip(rows, df.to_dict("records"), strict=True), 1):
-        assert row["number"][1] == str(n) and row["kind"][1] == rec["kind"]
-        for col, (factor, digits) in SHOWN.items():
-            value, shown = row[col]
-            want = float(rec[col])
-            if math.isnan(want):
-                assert value == "nan" and shown == MISSING
-            else:
-                assert float(value) == want
-                assert shown == f"{want * factor:.{digits}f}"
+    from test_report import assert_table_is_detects
+
+    assert_table_is_detects(rows, df)
 
 
 def test_report_in_the_browser(browser, tmp_path):

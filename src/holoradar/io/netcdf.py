@@ -294,7 +294,13 @@ def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
     if data.shape[-2:] != (y.size, x.size) or (has_z and data.shape[-3:-2] != need):
         raise ValueError(f"{what}: image of shape {data.shape} does not match z {z.size}, "
                          f"y {y.size}, x {x.size}")
-    return Image(data, x, y, z, freq, str(ds.attrs.get("method", "angular")), has_z_axis=has_z)
+    try:
+        steps = json.loads(str(ds.attrs.get("history", "[]")))
+    except ValueError:
+        steps = []
+    history = tuple(s for s in steps if isinstance(s, dict)) if isinstance(steps, list) else ()
+    return Image(data, x, y, z, freq, str(ds.attrs.get("method", "angular")), has_z_axis=has_z,
+                 history=history)
 
 
 class _Variable:

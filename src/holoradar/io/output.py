@@ -33,13 +33,14 @@ def default_mode() -> int:
 
 def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
                  inputs: Iterable[str | os.PathLike[str]] = (), overwrite: bool = False,
-                 name: str = "path", folder: bool = False) -> Path:
+                 name: str = "path", folder: bool = False,
+                 replace_word: str | None = None) -> Path:
     """Validate an output path before any computation; return it as a ``Path``.
 
     ``folder=True`` for an output that is itself a folder (a Zarr store). A
     ``name`` that is a command-line option (``--out``, ``--out's PNG``) gets the
     command line's word in a refusal (``--force``); any other the API's
-    (``overwrite=True``).
+    (``overwrite=True``), unless ``replace_word`` names the caller's own.
 
     Raises
     ------
@@ -78,7 +79,7 @@ def check_output(path: str | os.PathLike[str], *, suffixes: Iterable[str],
     if target.is_dir() and not folder:
         raise ValueError(f"{name} {str(target)!r} is a folder")
     if target.exists() and not overwrite:
-        how = "--force" if name.startswith("--") else "overwrite=True"
+        how = replace_word or ("--force" if name.startswith("--") else "overwrite=True")
         raise ValueError(f"{name} {str(target)!r} exists: pass {how} to replace it")
     return target
 

@@ -62,7 +62,8 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
            kinds: Sequence[str] = _KINDS, z: Any = None, hologram: Any = None,
            detections: Any = None, title: str = "Inspection report", force: bool = False,
            layout: Any = None, check: bool = True,
-           names: Mapping[str, str] | None = None) -> dict[str, Any]:
+           names: Mapping[str, str] | None = None, min_cover: Any = None,
+           meta: Any = None) -> dict[str, Any]:
     """Write the inspection report of images, holograms or surveys: one HTML file.
 
     Each source gets a section: its objects (found by :func:`holoradar.detect`, or
@@ -113,6 +114,13 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
         :func:`holoradar.load`'s plausibility checks (default True).
     names : mapping, optional
         How messages name the arguments (the command line gives its options' names).
+    min_cover : float or str, optional
+        The specified minimum concrete cover: metres, or text with its unit
+        (``"35mm"``). Each bar is checked against it (below, uncertain, ok) in the
+        objects' table, the layers' table and the rebar plan.
+    meta : mapping or path, optional
+        The inspection's fields (``site``, ``element``, ``operator``, ``scan``, ...),
+        or a TOML or JSON file of them: shown at the report's top.
 
     Returns
     -------
@@ -146,16 +154,19 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
     from ..io.output import check_output, write_atomic
     from .figures import pictures
     from .html import page
+    from .inspection import as_length, as_meta
 
     t0 = time.perf_counter()
     n = {**NAMES, **dict(names or {})}
+    cover = as_length(min_cover, n.get("min_cover", "min_cover"))
+    fields = as_meta(meta, n.get("meta", "meta"))
     srcs = _sources(sources)
     files = [s for s in srcs if isinstance(s, str | os.PathLike)]
     holos = as_list(hologram, len(srcs), n["hologram"])
     tables = as_list(detections, len(srcs), n["detections"])
     target = check_output(path, suffixes=[".html"], inputs=[*files, *[
         h for h in holos if isinstance(h, str | os.PathLike)]], overwrite=force,
-        name=n["path"])
+        name=n["path"], replace_word="--force" if n["path"].startswith("--") else "force=True")
     interval, how = _interval(eps_interval, n["eps_interval"])
     if medium is not None and not hasattr(medium, "z_interfaces"):
         raise ValueError(f"{n['medium']} must be a holoradar.Medium or None, got "
@@ -165,9 +176,11 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
                   kinds=_kinds(kinds), z=z, names=n, layout=layout, check=bool(check))
     sections = [build_section(s, i, req, hologram=h, detections=d)
                 for i, (s, h, d) in enumerate(zip(srcs, holos, tables, strict=True))]
+    for s in sections:
+        s.min_cover = cover
     pics = [pictures(s) for s in sections]
     created = time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime())
-    text = page(str(title), sections, pics, created, __version__)
+    text = page(str(title), sections, pics, created, __version__, fields)
     payload = text.encode("utf-8")
     write_atomic(target, payload)
     return {"path": str(target), "bytes": len(payload),

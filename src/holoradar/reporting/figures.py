@@ -218,7 +218,20 @@ def _picture(kind: str, caption: str, fig: Figure) -> Picture:
 
 
 def pictures(section: Section) -> list[Picture]:
-    """The plan views (and, for a volume, the sections) of one source."""
+    """The plan views (and, for a volume, the sections) of one source; where it holds
+    bars with depths, first the rebar plan (:func:`~.rebar.rebar_plan`)."""
+    from .rebar import rebar_plan
+
+    out = []
+    if len(section.table) and (section.table["kind"] == "line").any():
+        fig = rebar_plan(section.table, section.min_cover, f"{section.name}: bars by cover")
+        if fig is not None:
+            out.append(_picture("rebar", f"{section.name}: plan of the bars coloured by "
+                                         "cover", fig))
+    return out + _views(section)
+
+
+def _views(section: Section) -> list[Picture]:
     table = section.table
     cell = _cell(section)
     medium = section.ground.medium

@@ -15,6 +15,7 @@ from typing import Any
 
 from .figures import Picture
 from .model import Ground, Section
+from .rebar import rebar_html
 from .table import objects_table
 
 __all__ = ["page"]
@@ -40,6 +41,8 @@ ol.history li { margin-bottom: 6px; }
 pre { background: #f6f8fa; padding: 8px; overflow-x: auto; font-size: 12px;
       white-space: pre-wrap; }
 ul.warnings li { color: #9a6700; }
+tr.below td { background: #ffebe9; }
+table.rebar td { text-align: right; }
 .none { color: #57606a; font-style: italic; }
 p.note { color: #57606a; font-size: 13px; margin: 2px 0; }
 """
@@ -59,9 +62,10 @@ def _eps(e: complex) -> str:
     return f"{e.real:.4g}" + (f" + {e.imag:.3g}j" if e.imag else "")
 
 
-def ground_rows(g: Ground) -> list[tuple[str, str]]:
+def ground_rows(g: Ground, intervals: bool = True) -> list[tuple[str, str]]:
     """The ground as (label, value) rows: its layers' permittivities and ranges, how it was
-    found, and the permittivity interval.
+    found, and the permittivity interval (``intervals``: whether any depth has an
+    interval it could widen).
 
     Examples
     --------
@@ -90,7 +94,9 @@ def ground_rows(g: Ground) -> list[tuple[str, str]]:
         lo, hi = g.eps_interval
         rows.append(("eps' interval", f"{lo:.4g} to {hi:.4g}"
                      + (f", {g.interval_how}" if g.interval_how else "")
-                     + ": widens the depths' 95 % intervals"))
+                     + (": widens the depths' 95 % intervals" if intervals else
+                        ": no depth here has an interval to widen (each found on one plane "
+                        "from the image alone, at the plane's depth)")))
     else:
         rows.append(("eps' interval", "none given: the depth intervals are the range's "
                                       "uncertainty only"))
@@ -165,6 +171,9 @@ def _figure(p: Picture) -> str:
 
 
 _LEGEND = {
+    "rebar": "Every object numbered as in the table, coloured by its cover (depth below the "
+             "surface; the scale bar in cm); bars below the specified minimum cover dashed "
+             "over red, uncertain ones over dotted red; a point as a dot.",
     "plan": "|E| in dB re the brightest pixel. Objects outlined and numbered as in the "
             "table: a point as a circle one resolution cell across, a line from end to end, "
             "an area by its outline; each object on the plane nearest its range.",
@@ -174,10 +183,21 @@ _LEGEND = {
 }
 
 
+def _has_intervals(table: Any) -> bool:
+    if "depth_low" not in getattr(table, "columns", ()) or not len(table):
+        return True    # nothing to contradict
+    return any(math.isfinite(float(v)) for v in table["depth_low"]
+               if v is not None)
+
+
 def section_html(k: int, s: Section, pics: Sequence[Picture]) -> str:
     """One source's part of the page (``<section id="s{k}">``)."""
     key = f"s{k}"
     plans = "".join(_figure(p) for p in pics if p.kind == "plan")
+    rebar = rebar_html(s.table, s.min_cover, key)
+    if rebar:
+        rebar = ("<h3>Reinforcement: layers, spacing and cover</h3>" + rebar
+                 + "".join(_figure(p) for p in pics if p.kind == "rebar"))
     secs = "".join(_figure(p) for p in pics if p.kind == "section")
     frame = "the survey frame (the frames’ world positions)" if s.kind == "survey" \
         else "the image’s axes"
@@ -186,10 +206,10 @@ def section_html(k: int, s: Section, pics: Sequence[Picture]) -> str:
     return (f'<section id="{key}" data-source="{_e(s.name)}"><h2>{k}. {_e(s.name)}</h2>'
             f'<p class="meta">{what}; {len(s.table)} object(s); positions in cm on '
             f"{frame}; numbers as in <code>holoradar detect</code>.</p>"
-            f"<h3>Objects</h3>{objects_table(s.table, s.name, key)}"
+            f"<h3>Objects</h3>{objects_table(s.table, s.name, key, s.min_cover)}{rebar}"
             f"<h3>Plan views at the objects' depths</h3>{plans}"
             + (f"<h3>Vertical sections</h3>{secs}" if secs else "")
-            + f"<h3>Ground</h3>{_facts(ground_rows(s.ground))}"
+            + f"<h3>Ground</h3>{_facts(ground_rows(s.ground, _has_intervals(s.table)))}"
             f"<h3>Detection</h3>{_facts(detection_rows(s.detection, s.table))}"
             f"<h3>Device and settings</h3>{_facts(s.device)}"
             f"<h3>Processing history</h3>{_history(s.history)}"
@@ -197,8 +217,9 @@ def section_html(k: int, s: Section, pics: Sequence[Picture]) -> str:
 
 
 def page(title: str, sections: Sequence[Section], pictures: Sequence[Sequence[Picture]],
-         created: str, version: str) -> str:
-    """The whole document."""
+         created: str, version: str, meta: Sequence[tuple[str, str]] = ()) -> str:
+    """The whole document; ``meta`` the inspection's fields (site, element, operator,
+    scan...) shown first."""
     toc = "".join(f'<li><a href="#s{k}">{_e(s.name)}</a>: {len(s.table)} object(s)</li>'
                   for k, s in enumerate(sections, 1))
     total = sum(len(s.table) for s in sections)
@@ -211,4 +232,5 @@ def page(title: str, sections: Sequence[Section], pictures: Sequence[Sequence[Pi
             f"<h1>{_e(title)}</h1><p class=\"meta\">{len(sections)} source(s), {total} "
             f"object(s); made by holoradar {_e(version)} at {_e(created)} (UTC). Depths are "
             "below the ground surface, ranges from the array; intervals are 95 %.</p>"
-            f"<ol class=\"toc\">{toc}</ol>{body}</body></html>\n")
+            + (f"<h3>Inspection</h3>{_facts(meta)}" if meta else "")
+            + f"<ol class=\"toc\">{toc}</ol>{body}</body></html>\n")

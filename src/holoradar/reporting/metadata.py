@@ -162,10 +162,12 @@ def device_rows(obj: Any, attrs: dict[str, Any]) -> list[tuple[str, str]]:
                 f"{float(v):.3g}" for v in np.asarray(pol).ravel()) + ") (x, y, z)"))
     if obj.frequency is not None:
         rows.append(("frequency", _frequencies(obj.frequency)))
-    for key, label in (("holoradar_version", "written by holoradar"),
-                       ("holoradar_conventions", "file conventions")):
-        if key in attrs:
-            rows.append((label, str(attrs[key])))
+    if "holoradar_version" in attrs:
+        rows.append(("written by", f"holoradar {attrs['holoradar_version']}"))
+    if "holoradar_conventions" in attrs:
+        rows.append(("file layout", f"holoradar's NetCDF conventions, version "
+                                    f"{attrs['holoradar_conventions']} ("
+                                    f"{attrs.get('Conventions', 'CF')})"))
     return rows
 
 

@@ -60,6 +60,8 @@ class Section:
         (``"Category: message"``, each once).
     store : str or None
         A survey store's path (its mosaic is drawn).
+    min_cover : float or None
+        The specified minimum cover (m) the bars are checked against.
     """
 
     name: str
@@ -72,3 +74,4 @@ class Section:
     history: list[dict[str, Any]] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     store: str | None = None
+    min_cover: float | None = None

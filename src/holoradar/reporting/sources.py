@@ -117,6 +117,12 @@ def build_section(source: Any, index: int, req: Request, *, hologram: Any = None
         if text not in seen:
             seen.append(text)
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    # What the steps that made the source warned of (kept in its history).
+    for step in section.history:
+        for text in step.get("warnings") or []:
+            said = f"{text} (when {step.get('step', 'a step')} made it)"
+            if said not in seen:
+                seen.append(said)
     section.warnings = seen
     return section
 
@@ -141,6 +147,7 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
     else:
         raise ValueError(f"{n['sources']}: each source must be a file path, a holoradar Image "
                          f"or a Hologram, got {type(source).__name__}")
+    req = _interval_of(req, detections)
     ground = _ground(req, obj, path)
     args = {"false_alarm": req.false_alarm, "kinds": req.kinds,
             "eps_interval": req.eps_interval}
@@ -156,9 +163,25 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
             raise ValueError(f"{n['hologram']}: {name} is itself a hologram: give none")
         draw, table = _hologram_objects(obj, name, ground.medium, args, req, detections)
         kind = "hologram"
+    # An object keeps its history (an Image read by hr.load, or made here); a file's is
+    # in its attributes.
+    history = history_of(attrs) or [dict(s) for s in getattr(obj, "history", ()) or ()
+                                    if isinstance(s, dict)]
     return Section(name=name, kind=kind, image=draw, table=table, ground=ground,
                    detection=_detection(table, req), device=device_rows(obj, attrs) + extra,
-                   history=history_of(attrs))
+                   history=history)
+
+
+def _interval_of(req: Request, detections: Any) -> Request:
+    """The permittivity interval a given table was found with (its ``eps_interval``
+    attribute), where none is given to the report."""
+    from dataclasses import replace
+
+    got = (getattr(detections, "attrs", None) or {}).get("eps_interval")
+    if req.eps_interval is not None or not got:
+        return req
+    return replace(req, eps_interval=(float(got[0]), float(got[1])),
+                   interval_how="the one the objects' table was found with")
 
 
 def _read_hologram(hologram: Any, req: Request) -> tuple[Any, dict[str, Any]]:
@@ -283,6 +306,7 @@ def _store_section(path: Path, name: str, req: Request, hologram: Any,
         raise ValueError(f"{n['hologram']}: a survey store's frames are fitted with their own "
                          "holograms: give none")
     medium = stored_settings(path)[0].medium
+    req = _interval_of(req, detections)
     if req.eps_interval is not None and (medium is None or not medium.z_interfaces):
         raise ValueError(f"{n['eps_interval']} needs a ground: the store {name} was imaged in "
                          "free space")

@@ -43,17 +43,28 @@ def _number(v: Any) -> float:
         return math.nan
 
 
-def _cell(col: str, value: Any, factor: float, digits: int) -> str:
+def _cell(col: str, value: Any, factor: float, digits: int, blank: bool = False) -> str:
+    """One cell; ``blank``: the value is not defined for the object (shown as
+    :data:`MISSING`, kept exact in ``data-value``)."""
     v = _number(value)
-    shown = MISSING if not math.isfinite(v) else f"{v * factor:.{digits}f}"
+    shown = math.nan if blank else v * factor
+    if col == "azimuth_deg" and math.isfinite(shown):
+        shown = round(shown, digits) % 180.0    # an axis: 180 deg is 0 deg
+    # + 0.0 turns the -0.0 of a small negative value's rounding into 0.0
+    shown = MISSING if not math.isfinite(shown) else \
+        f"{round(shown, digits) + 0.0:.{digits}f}"
     return f'<td data-col="{col}" data-value="{html.escape(repr(v))}">{shown}</td>'
 
 
-def objects_table(table: Any, source: str, key: str = "s1") -> str:
+def objects_table(table: Any, source: str, key: str = "s1",
+                  min_cover: float | None = None) -> str:
     """The table's HTML (``<table class="objects">``), or a sentence when it is empty.
 
     ``source`` names the source (``data-source``); ``key`` prefixes the rows' ids
-    (``{key}-object-{n}``).
+    (``{key}-object-{n}``); with ``min_cover`` (m) a column checks each bar's cover
+    against it (:func:`~.rebar.cover_status`). A point's length and width, and the
+    azimuth of a point, are not defined and show as blank; an azimuth is shown in
+    [0, 180) degrees; no value shows as ``-0``.
 
     Examples
     --------
@@ -65,18 +76,31 @@ def objects_table(table: Any, source: str, key: str = "s1") -> str:
     """
     if len(table) == 0:
         return '<p class="none">No object above the threshold.</p>'
+    from .rebar import cover_status
+
     cols = [c for c in COLUMNS if c[0] in table.columns]
-    frame = "frame" in table.columns
+    frame = "frames" if "frames" in table.columns else "frame" if "frame" in table.columns \
+        else None
+    check = min_cover is not None
     head = "".join(f"<th>{html.escape(h)}</th>" for _, h, _, _ in cols)
     rows = []
     for i, rec in enumerate(table.to_dict("records")):
-        cells = "".join(_cell(c, rec.get(c), f, d) for c, _, f, d in cols)
-        extra = f'<td data-col="frame">{html.escape(str(rec["frame"]))}</td>' if frame else ""
-        rows.append(f'<tr id="{key}-object-{i + 1}"><td data-col="number">'
+        point = rec.get("kind") == "point"
+        cells = "".join(_cell(c, rec.get(c), f, d, point and c in ("length", "width"))
+                        for c, _, f, d in cols)
+        extra = f'<td data-col="frame">{html.escape(str(rec[frame]).replace(";", ", "))}' \
+            "</td>" if frame else ""
+        status = cover_status(rec, min_cover) if check else ""
+        if check:
+            extra += f'<td data-col="cover_check">{status or MISSING}</td>'
+        cls = ' class="below"' if status == "below" else ""
+        rows.append(f'<tr id="{key}-object-{i + 1}"{cls}><td data-col="number">'
                     f'{i + 1}</td><td data-col="kind">{html.escape(str(rec["kind"]))}</td>'
                     f"{cells}{extra}</tr>")
+    more = ("<th>frames seen in</th>" if frame == "frames" else "<th>frame</th>" if frame
+            else "") + (f"<th>cover ≥ {min_cover * 100:.1f} cm?</th>" if check else "")
     return (f'<table class="objects" data-source="{html.escape(source)}"><thead><tr>'
-            f'<th>#</th><th>kind</th>{head}{"<th>frame</th>" if frame else ""}</tr></thead>'
+            f'<th>#</th><th>kind</th>{head}{more}</tr></thead>'
             f'<tbody>{"".join(rows)}</tbody></table>{_notes(table)}')
 
 
@@ -94,6 +118,6 @@ def _notes(table: Any) -> str:
     if "depth" in table.columns and not any(math.isfinite(_number(d)) for d in table["depth"]):
         notes.append("No depths: no ground with a surface was given or found; ranges are "
                      "from the array.")
-    notes.append(f"{MISSING}: not defined for this kind of object (an azimuth or area for a "
-                 "point) or not measured.")
+    notes.append(f"{MISSING}: not defined for this kind of object (a point's length, width, "
+                 "azimuth or area) or not measured.")
     return "".join(f'<p class="note">{html.escape(n)}</p>' for n in notes)

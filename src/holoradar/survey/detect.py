@@ -84,6 +84,8 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
         if log is not None:
             log(f"frame {idx['frame_name'][i]}: {len(df)} object(s)")
     merged = _gathered(tables)
+    merged.attrs["eps_interval"] = None if args.get("eps_interval") is None else \
+        list(args["eps_interval"])
     info = {"input": "survey", "frames": len(frames), "model": "hologram" if plane is None
             else "window", "plane_m": plane, "per_frame": [
                 {"frame": str(idx["frame_name"][i]), "array_z_m": float(idx["frame_z"][i]),

@@ -95,7 +95,8 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         image amplitude), ``snr_db`` (its intensity over the local noise),
         ``x_std``, ``y_std``, ``range_std`` (metres), ``model_error_db`` (what the
         model leaves of the object, relative, dB), ``area`` (m^2; areas). ``df.attrs``
-        holds the threshold, the noise, the cell and the areas' ``outlines``.
+        holds the threshold, the noise, the cell, the permittivity interval
+        (``eps_interval``) and the areas' ``outlines``.
 
     Raises
     ------
@@ -127,7 +128,7 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         rows, meta = detect_by_inversion(vol, hologram, medium, dict(migrate_options or {}),
                                          noise,
                                          interval, fa, int(max_objects))
-        return _frame([r for r in rows if r["kind"] in ks], meta, fa)
+        return _frame([r for r in rows if r["kind"] in ks], meta, fa, interval)
     if migrate_options:
         raise ValueError("migrate_options needs hologram=")
     if noise is not None:
@@ -148,12 +149,13 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
                     model.kind)
 
         rows, meta = detect_planes(vol, run_plane, fa, medium, interval)
-        return _frame(rows, meta, fa)
+        return _frame(rows, meta, fa, interval)
     model = _image_model(vol, medium)
     rows, result = _one(vol, model, medium, fa, ks, int(max_objects), interval)
     return _frame(rows, {"threshold": float(result.noise.t),
                          "resolution_cell": [float(c) for c in result.noise.cell],
-                         "n_cells": float(result.noise.n_cells), "model": model.kind}, fa)
+                         "n_cells": float(result.noise.n_cells), "model": model.kind}, fa,
+                  interval)
 
 
 def _wideband(vol: Volume) -> bool:
@@ -190,12 +192,14 @@ def _one(vol: Volume, model: Any, medium: Any, fa: float, ks: set[str], max_obje
     return rows, result
 
 
-def _frame(rows: list[dict[str, Any]], meta: dict[str, Any], fa: float) -> Any:
+def _frame(rows: list[dict[str, Any]], meta: dict[str, Any], fa: float,
+           interval: tuple[float, float] | None = None) -> Any:
     import pandas as pd
 
     df = pd.DataFrame(rows, columns=COLUMNS)
     df.attrs.update(meta)
     df.attrs.update({"false_alarm": fa,
+                     "eps_interval": None if interval is None else list(interval),
                      "outlines": {i: r["outline"] for i, r in enumerate(rows) if "outline" in r}})
     return df
 

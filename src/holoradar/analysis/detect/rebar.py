@@ -1,21 +1,25 @@
-"""A rebar mat's summary: per direction of bars, their number, spacing and cover."""
+"""A rebar mat's summary: per layer of bars (a direction and a depth), their number,
+spacing and cover."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 __all__ = ["rebar_layers"]
 
-LAYER_COLUMNS = ["azimuth_deg", "bars", "spacing", "spacing_min", "spacing_max", "cover",
-                 "cover_low", "cover_high", "rows"]
+LAYER_COLUMNS = ["azimuth_deg", "bars", "spacing", "spacing_mean", "spacing_min",
+                 "spacing_max", "cover", "cover_mean", "cover_min", "cover_max", "cover_low",
+                 "cover_high", "rows"]
 """Columns of :func:`rebar_layers`'s table, in order."""
 
 
 def rebar_layers(objects: Any, *, angle_tol_deg: float = 10.0) -> Any:
-    """Group the lines of a :func:`~holoradar.detect` table by direction: one row per
-    layer of parallel bars, as a rebar scanner reports a mat.
+    """Group the lines of a :func:`~holoradar.detect` table into layers: one row per
+    layer of parallel bars (a direction, and within it a depth), as a rebar scanner
+    reports a mat.
 
     Parameters
     ----------
@@ -29,14 +33,17 @@ def rebar_layers(objects: Any, *, angle_tol_deg: float = 10.0) -> Any:
     Returns
     -------
     pandas.DataFrame
-        One row per direction, most bars first: ``azimuth_deg`` (the lines' mean,
-        degrees from +x towards +y in [0, 180)); ``bars``; ``spacing`` (metres, the
-        median distance between neighbouring bars across their direction) with
-        ``spacing_min``/``spacing_max``; ``cover`` (metres, the bars' median
-        depth: the depth of a bar's top, where its echo comes from) with
-        ``cover_low``/``cover_high`` (the extremes of the bars' depth intervals);
-        ``rows`` (the lines' row labels in ``objects``). Spacing is NaN for one bar,
-        cover NaN without depths.
+        One row per layer, most bars first (then the shallower): ``azimuth_deg`` (the
+        lines' mean, degrees from +x towards +y in [0, 180)); ``bars``; ``spacing``
+        (metres, the median distance between neighbouring bars across their
+        direction) with ``spacing_mean``, ``spacing_min``, ``spacing_max``; ``cover``
+        (metres, the bars' median depth: the depth of a bar's top, where its echo
+        comes from) with ``cover_mean``, ``cover_min``, ``cover_max`` and
+        ``cover_low``/``cover_high`` (the extremes of the bars' 95 % depth
+        intervals); ``rows`` (the lines' row labels in ``objects``). Spacing is NaN
+        for one bar, cover NaN without depths. Bars of one direction are one layer
+        unless a bar lies more than :data:`LAYER_GAP` below the previous (sorted by
+        depth) with its interval wholly below the layer's: it starts the next.
 
     Raises
     ------
@@ -75,9 +82,41 @@ def rebar_layers(objects: Any, *, angle_tol_deg: float = 10.0) -> Any:
                 break
         else:
             groups.append([label])
-    out = [_layer(lines.loc[g]) | {"rows": list(g)} for g in groups]
-    out.sort(key=lambda r: -r["bars"])
+    out = [_layer(lines.loc[d]) | {"rows": list(d)} for g in groups
+           for d in _by_depth(lines.loc[g])]
+    out.sort(key=lambda r: (-r["bars"], r["cover"] if math.isfinite(r["cover"]) else 0.0))
     return pd.DataFrame(out, columns=LAYER_COLUMNS)
+
+
+LAYER_GAP = 0.025
+"""Metres: a second mat of bars in the same direction lies at least this much deeper
+(its bars under the crossing bars of the first, two bar diameters of 10-16 mm); bars of
+one layer differ by less (a badly placed bar by a centimetre or so, which the cover
+check must show rather than call another layer)."""
+
+
+def _by_depth(rows: Any) -> list[list[Any]]:
+    """One direction's bars split into layers: sorted by depth, a new layer where a bar
+    lies more than :data:`LAYER_GAP` below the previous one and its 95 % depth interval
+    wholly below every interval of the layer so far."""
+    if "depth" not in rows or not np.isfinite(rows["depth"].to_numpy(float)).any():
+        return [list(rows.index)]
+    order = rows.sort_values("depth", kind="stable")
+    lo = order["depth_low"] if "depth_low" in order else order["depth"]
+    hi = order["depth_high"] if "depth_high" in order else order["depth"]
+    layers: list[list[Any]] = []
+    top, last = -math.inf, -math.inf
+    for label, d, a, b in zip(order.index, order["depth"], lo, hi, strict=True):
+        a = d if not math.isfinite(a) else a
+        b = d if not math.isfinite(b) else b
+        if not layers or (math.isfinite(d) and a > top and d - last > LAYER_GAP):
+            layers.append([label])
+            top = -math.inf
+        else:
+            layers[-1].append(label)
+        top = max(top, b) if math.isfinite(b) else top
+        last = d if math.isfinite(d) else last
+    return layers
 
 
 def _angle_gap(a: float, b: float) -> float:
@@ -104,6 +143,8 @@ def _layer(rows: Any) -> dict[str, Any]:
         return float(f(a)) if a.size else float("nan")
 
     return {"azimuth_deg": az, "bars": len(rows),
-            "spacing": stat(np.median, gaps), "spacing_min": stat(np.min, gaps),
-            "spacing_max": stat(np.max, gaps), "cover": stat(np.median, depth),
+            "spacing": stat(np.median, gaps), "spacing_mean": stat(np.mean, gaps),
+            "spacing_min": stat(np.min, gaps), "spacing_max": stat(np.max, gaps),
+            "cover": stat(np.median, depth), "cover_mean": stat(np.mean, depth),
+            "cover_min": stat(np.min, depth), "cover_max": stat(np.max, depth),
             "cover_low": stat(np.min, lo), "cover_high": stat(np.max, hi)}

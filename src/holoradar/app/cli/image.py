@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -91,23 +92,33 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
     if png:
         check_output(out.with_suffix(".png"), suffixes=[".png"], inputs=[hologram_file],
                      overwrite=force, name="--out's PNG")
-    holo = read_hologram(hologram_file, layout, check)
-    medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
-    check_planes(holo, zs, z, medium, medium_spec, check)
-    t0 = time.perf_counter()
-    img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
-                  progress=report.progress)
-    seconds = time.perf_counter() - t0
-    pk = peak_position(img)
-    # data in the other I/Q convention, a picture of the glare: said, with the fix
-    check_image(hologram_file, holo, img, medium, medium_spec, zs, layout=layout,
-                method=method, frame=frame, upsample=upsample)
+    # What was warned of on the way is said now and kept in the image's history (a
+    # report of the image lists it).
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        holo = read_hologram(hologram_file, layout, check)
+        medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
+        check_planes(holo, zs, z, medium, medium_spec, check)
+        t0 = time.perf_counter()
+        img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
+                      progress=report.progress)
+        seconds = time.perf_counter() - t0
+        pk = peak_position(img)
+        # data in the other I/Q convention, a picture of the glare: said, with the fix
+        check_image(hologram_file, holo, img, medium, medium_spec, zs, layout=layout,
+                    method=method, frame=frame, upsample=upsample)
+    texts: list[str] = []
+    for w in said:
+        text = f"{w.category.__name__}: {' '.join(str(w.message).split())}"
+        if text not in texts:
+            texts.append(text)
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     ground = None if medium is None else {"z_interfaces": list(medium.z_interfaces),
                                            "eps": [str(e) for e in medium.eps]}
     history = [*input_history(hologram_file, layout), {
         "step": "migrate", "input": hologram_file.name,
         "parameters": {"z": z, "method": method, "frame": frame, "upsample": upsample,
-                       "layout": layout, "medium": ground}}]
+                       "layout": layout, "medium": ground}, "warnings": texts}]
     files = write_image(img, out, force, history, png, f"{hologram_file.name} ({method})")
     report.done({"peak_m": pk, "out": str(out), "files": files, "planes": int(img.z.size),
                  "shape": list(img.data.shape), "seconds": seconds}, [

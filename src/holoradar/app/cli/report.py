@@ -20,7 +20,31 @@ __all__ = ["COMMANDS"]
 
 _NAMES = {"sources": "FILE", "path": "--out", "z": "--z", "hologram": "--hologram",
           "medium": "--eps/--z-surface", "eps_interval": "--eps-interval",
-          "detections": "detections"}
+          "detections": "detections", "min_cover": "--min-cover", "meta": "--meta"}
+_FIELDS = ("site", "element", "operator", "scan")
+
+
+def _min_cover(ctx: Any, param: Any, value: str | None) -> float | None:
+    from ...reporting.inspection import as_length
+
+    try:
+        return as_length(value, "--min-cover")
+    except ValueError as exc:
+        raise click.BadParameter(str(exc).removeprefix("--min-cover: "),
+                                 param_hint="--min-cover") from None
+
+
+def _meta(meta: Path | None, given: dict[str, str | None]) -> dict[str, str]:
+    """``--meta FILE``'s fields, overridden by the options given."""
+    from ...reporting.inspection import as_meta
+
+    try:
+        fields = dict(as_meta(meta, "--meta"))
+    except ValueError as exc:
+        raise click.BadParameter(str(exc).removeprefix("--meta: "), param_hint="--meta") \
+            from None
+    fields.update({k: v for k, v in given.items() if v})
+    return fields
 
 
 def _medium(files: list[Path], spec: dict[str, Any], layout: str | None, check: bool) -> Any:
@@ -54,20 +78,34 @@ def _medium(files: list[Path], spec: dict[str, Any], layout: str | None, check: 
                    "its point response fitted to it (one FILE only).")
 @click.option("--title", default="Inspection report", show_default=True,
               help="The report's heading.")
+@click.option("--min-cover", default=None, metavar="LENGTH", callback=_min_cover,
+              help="The specified minimum concrete cover, e.g. 35mm or 3.5cm: bars below "
+                   "it are marked in the tables and on the rebar plan.")
+@click.option("--meta", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              default=None,
+              help="A TOML or JSON file of the inspection's fields (site, element, operator, "
+                   "scan, date, ...), shown at the report's top.")
+@click.option("--site", default=None, help="The site (overrides --meta's).")
+@click.option("--element", default=None, help="The element scanned, e.g. 'slab S3, bay 2'.")
+@click.option("--operator", default=None, help="Who scanned.")
+@click.option("--scan", default=None, help="The scan's name or number.")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
 @layout_option
 @output_options
 def report(files: tuple[Path, ...], out: Path, z: str | None, medium_spec: dict[str, Any],
            eps_interval: str | None, false_alarm: str, kinds: str, hologram: Path | None,
-           title: str, force: bool, layout: str | None, check: bool,
-           report: Reporter) -> None:
+           title: str, min_cover: float | None, meta: Path | None, site: str | None,
+           element: str | None, operator: str | None, scan: str | None, force: bool,
+           layout: str | None, check: bool, report: Reporter) -> None:
     """Write the inspection report of images, holograms or survey stores.
 
     FILE...: images (holoradar image/mosaic), holograms (imaged on --z first) or
     survey stores (.zarr from holoradar batch), one section each. The report holds
     the objects (numbered as holoradar detect numbers them) outlined on plan views
     at their depths, their table, the ground, the device and settings, the
-    processing history and the warnings; -o names it (.html).
+    processing history and the warnings; bars are summarised per layer (count,
+    spacing, cover against --min-cover) with a plan coloured by cover; -o names it
+    (.html).
     """
     from ...io.output import check_output
     from ...reporting import report as write_report
@@ -82,11 +120,14 @@ def report(files: tuple[Path, ...], out: Path, z: str | None, medium_spec: dict[
     if hologram is not None and len(paths) != 1:
         raise click.BadParameter(f"--hologram is the hologram of one image FILE; {len(paths)} "
                                  "FILEs given", param_hint="--hologram")
+    fields = _meta(meta, {"site": site, "element": element, "operator": operator,
+                          "scan": scan})
     zs = depth_ranges(z) if z is not None else None
     medium = _medium(paths, medium_spec, layout, check)
     summary = write_report(paths, out, medium=medium, eps_interval=interval, false_alarm=fa,
                            kinds=ks, z=zs, hologram=hologram, title=title, force=force,
-                           layout=layout, check=check, names=_NAMES)
+                           layout=layout, check=check, names=_NAMES, min_cover=min_cover,
+                           meta=fields)
     lines = []
     for s in summary["sources"]:
         lines.append(f"{s['name']}: {s['n_objects']} object(s)"
