@@ -66,8 +66,9 @@ def geojson(df: Any, metadata: dict[str, Any], frame: str, crs: Any = None,
     --------
     >>> import pandas as pd
     >>> df = pd.DataFrame([{"kind": "point", "x": 500000.0, "y": 0.0}])
-    >>> geojson(df, {}, "survey", "EPSG:32633")["features"][0]["geometry"]
-    {'type': 'Point', 'coordinates': [15.0, 0.0]}
+    >>> g = geojson(df, {}, "survey", "EPSG:32633")["features"][0]["geometry"]
+    >>> g["type"], [round(v, 9) for v in g["coordinates"]]
+    ('Point', [15.0, 0.0])
     """
     from .crs import as_crs, crs_name, to_lonlat
 
@@ -199,9 +200,12 @@ def table_lines(df: Any) -> list[str]:
         if r["kind"] != "point" and np.isfinite(r.get("length", np.nan)):
             size = f"  length {r['length'] * 100:.1f} cm"
             if np.isfinite(r.get("azimuth_deg", np.nan)):
-                size += f" at {r['azimuth_deg']:.0f} deg"
-        frame = f"  ({r['frame']})" if "frame" in r else ""
-        lines.append(f"{n + 1:>3}  {r['kind']:<6} {r['x'] * 100:>7.1f} {r['y'] * 100:>7.1f}  "
+                size += f" at {round(r['azimuth_deg']) % 180:.0f} deg"   # an axis: 180 is 0
+        frame = f"  ({r['frames'].replace(';', ', ')})" if isinstance(r.get("frames"), str) \
+            else f"  ({r['frame']})" if "frame" in r else ""
+        # + 0.0: a small negative value rounds to 0.0, not -0.0
+        x, y = (round(r[k] * 100, 1) + 0.0 for k in ("x", "y"))
+        lines.append(f"{n + 1:>3}  {r['kind']:<6} {x:>7.1f} {y:>7.1f}  "
                      f"{where:<22} {r['amplitude_db']:>7.1f} {r['snr_db']:>7.1f}{size}{frame}")
     return lines
 

@@ -64,7 +64,7 @@ def merge(df: Any) -> Any:
     ...             "frame": frame, "_off": off, "_cell": 0.02}
     >>> t = merge(pd.DataFrame([line("a", -0.3, -0.05, 0.1), line("b", -0.1, 0.15, 0.0),
     ...                         line("c", 0.1, 0.3, 0.1)]))
-    >>> len(t), round(t.length[0], 3), t.frames[0]
+    >>> len(t), round(float(t.length[0]), 3), t.frames[0]
     (1, 0.6, 'a;b;c')
     """
     import pandas as pd
