@@ -96,3 +96,16 @@ def test_pipe_across_seven_frames_is_one_line_in_survey_coordinates(tmp_path):
     assert abs(o["y"] - 0.1) < cell / 4
     assert sorted([o["x_start"], o["x_end"]]) == pytest.approx([-0.3, 0.3], abs=cell)
     assert o["frames"] == ";".join(f"f{i}.nc" for i in range(7))
+
+
+def test_progress_bars_only_on_a_terminal(monkeypatch):
+    # A bar redraws its line with carriage returns: on a terminal only, never with -q.
+    import sys
+
+    from holoradar.app.cli.common import Reporter
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
+    assert Reporter(False, False).progress is False
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    assert Reporter(False, False).progress is True
+    assert Reporter(False, True).progress is False

@@ -63,7 +63,7 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
            detections: Any = None, title: str = "Inspection report", force: bool = False,
            layout: Any = None, check: bool = True,
            names: Mapping[str, str] | None = None, min_cover: Any = None,
-           meta: Any = None) -> dict[str, Any]:
+           meta: Any = None, progress: bool | None = None) -> dict[str, Any]:
     """Write the inspection report of images, holograms or surveys: one HTML file.
 
     Each source gets a section: its objects (found by :func:`holoradar.detect`, or
@@ -121,6 +121,9 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
     meta : mapping or path, optional
         The inspection's fields (``site``, ``element``, ``operator``, ``scan``, ...),
         or a TOML or JSON file of them: shown at the report's top.
+    progress : bool, optional
+        Progress bars over the detection's long work (an inversion's steps, a survey's
+        frames); default: once the work has lasted a second; False: never.
 
     Returns
     -------
@@ -173,7 +176,8 @@ def report(sources: Any, path: str | os.PathLike[str], *, medium: Any = None,
                          f"{type(medium).__name__}")
     req = Request(medium=medium, eps_interval=interval,
                   interval_how=how, false_alarm=_false_alarm(false_alarm),
-                  kinds=_kinds(kinds), z=z, names=n, layout=layout, check=bool(check))
+                  kinds=_kinds(kinds), z=z, names=n, layout=layout, check=bool(check),
+                  progress=progress)
     sections = [build_section(s, i, req, hologram=h, detections=d)
                 for i, (s, h, d) in enumerate(zip(srcs, holos, tables, strict=True))]
     for s in sections:

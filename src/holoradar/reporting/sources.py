@@ -57,6 +57,8 @@ class Request:
         Where the hologram is in a user's file (:func:`holoradar.load`).
     check : bool
         The plausibility checks of :func:`holoradar.load`.
+    progress : bool or None
+        The detection's progress bars (None: after a second of work).
     """
 
     medium: Any = None
@@ -68,6 +70,7 @@ class Request:
     names: Mapping[str, str] = field(default_factory=lambda: dict(NAMES))
     layout: Any = None
     check: bool = True
+    progress: bool | None = None
 
 
 def _name(source: Any, index: int) -> str:
@@ -150,7 +153,7 @@ def _build(source: Any, index: int, req: Request, hologram: Any, detections: Any
     req = _interval_of(req, detections)
     ground = _ground(req, obj, path)
     args = {"false_alarm": req.false_alarm, "kinds": req.kinds,
-            "eps_interval": req.eps_interval}
+            "eps_interval": req.eps_interval, "progress": req.progress}
     extra: list[tuple[str, str]] = []
     if isinstance(obj, Image):
         if hologram is not None:
@@ -319,7 +322,7 @@ def _store_section(path: Path, name: str, req: Request, hologram: Any,
         try:
             table, info, _ = from_store(path, _stored_plane(req), {
                 "false_alarm": req.false_alarm, "kinds": req.kinds,
-                "eps_interval": req.eps_interval})
+                "eps_interval": req.eps_interval, "progress": req.progress})
         except DetectionInputError as exc:
             raise ValueError(f"{n['z'] if exc.name == 'z' else n['sources']}: {exc}") from None
     detection = _detection(table, req)

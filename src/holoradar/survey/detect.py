@@ -41,7 +41,7 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
         stored plane (range from the frames' arrays, m) searched from the images alone.
     args : mapping
         :func:`~holoradar.detect`'s other keywords (``false_alarm``, ``kinds``,
-        ``eps_interval``).
+        ``eps_interval``; ``progress``: a bar over the frames, default after a second).
     log : callable, optional
         Told a line per frame (its number of objects).
 
@@ -76,13 +76,26 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
         raise ValueError(f"{path.name} holds no finished frame")
     if plane is not None:
         refuse_outside(plane, settings.z, "stored planes")
+    from tqdm.auto import tqdm
+
     holograms = _holograms(idx, frames) if plane is None else {}
     tables = []
-    for i in frames:
-        df = _frame_objects(path, i, idx, settings, holograms.get(i), plane, args)
-        tables.append(df)
-        if log is not None:
-            log(f"frame {idx['frame_name'][i]}: {len(df)} object(s)")
+    # One bar over the frames (each frame's own inversion silent).
+    args = dict(args)
+    shown = args.pop("progress", None)
+    args["progress"] = False
+    with tqdm(total=len(frames), desc="detect (frames)", unit="frame", delay=1.0,
+              disable=shown is False) as bar:
+        for i in frames:
+            df = _frame_objects(path, i, idx, settings, holograms.get(i), plane, args)
+            tables.append(df)
+            bar.update(1)
+            if log is not None:
+                text = f"frame {idx['frame_name'][i]}: {len(df)} object(s)"
+                if bar.disable:
+                    log(text)
+                else:           # above the bar, which stays at the bottom
+                    bar.write(text)
     merged = _gathered(tables)
     merged.attrs["eps_interval"] = None if args.get("eps_interval") is None else \
         list(args["eps_interval"])

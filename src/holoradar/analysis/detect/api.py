@@ -41,7 +41,8 @@ def _check(false_alarm: Any, kinds: Any, medium: Any, eps_interval: Any) -> tupl
 def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
            false_alarm: float = 1e-3, kinds: Sequence[str] = _KINDS,
            hologram: Any = None, migrate_options: Mapping[str, Any] | None = None,
-           max_objects: int = 100, noise: float | None = None) -> Any:
+           max_objects: int = 100, noise: float | None = None,
+           progress: bool | None = None) -> Any:
     """The objects in an image: what, where, how deep, how big, how sure.
 
     Parameters
@@ -81,6 +82,9 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
         hologram's units (default: estimated from its evanescent band, or, where its
         pitch leaves none, assumed 40 dB below its power with a ``NoiseWarning``; a
         noise set too low lets the inversion fit it, and spurious pieces follow).
+    progress : bool, optional
+        With ``hologram``: a progress bar over the inversion's steps (default: once
+        the work has lasted a second; False: never).
 
     Returns
     -------
@@ -127,7 +131,7 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
 
         rows, meta = detect_by_inversion(vol, hologram, medium, dict(migrate_options or {}),
                                          noise,
-                                         interval, fa, int(max_objects))
+                                         interval, fa, int(max_objects), progress)
         return _frame([r for r in rows if r["kind"] in ks], meta, fa, interval)
     if migrate_options:
         raise ValueError("migrate_options needs hologram=")

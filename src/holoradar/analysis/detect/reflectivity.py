@@ -66,7 +66,7 @@ DYNAMIC_RANGE_DB = -22.0
 
 def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any],
                         noise: float | None, interval: tuple[float, float] | None,
-                        false_alarm: float, max_objects: int
+                        false_alarm: float, max_objects: int, progress: bool | None = False
                         ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Rows of ``detect``'s table and its attributes (see the module docstring)."""
     from ...imaging.inversion.api import reflectivity
@@ -101,7 +101,7 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     grid.setdefault("dtype", np.complex64)
 
     def invert(sigma: float | None, steps: int) -> Any:
-        return reflectivity(hologram, zs, medium=medium, method=method, progress=False,
+        return reflectivity(hologram, zs, medium=medium, method=method, progress=progress,
                             max_iter=steps if method == "sparse" else None,
                             false_alarm=p, need_source=False, noise=sigma, **grid)
 

@@ -36,8 +36,12 @@ class Reporter:
 
     @property
     def progress(self) -> bool:
-        """Whether progress bars are shown (on stderr)."""
-        return not self.quiet
+        """Whether progress bars are shown: on a terminal's stderr only (a bar redraws
+        its line with carriage returns: in a pipe or a log file it is hundreds of lines
+        of noise), never with ``--quiet``."""
+        import sys
+
+        return not self.quiet and sys.stderr.isatty()
 
     def line(self, text: str) -> None:
         """A narrative line (hidden by ``--quiet`` and ``--json``)."""

@@ -256,7 +256,7 @@ def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval:
         check_output(out, suffixes=SUFFIXES, inputs=inputs, overwrite=force, name="--out")
     interval = _eps_interval(eps_interval)
     args = {"false_alarm": _false_alarm(false_alarm), "kinds": _kinds(kinds)}
-    full = {**args, "eps_interval": interval}
+    full = {**args, "eps_interval": interval, "progress": report.progress}
     store = file.is_dir()
     if store and not is_survey(file):
         raise click.BadParameter(f"{file} is a folder but not a survey store (holoradar batch "

@@ -127,7 +127,7 @@ def report(files: tuple[Path, ...], out: Path, z: str | None, medium_spec: dict[
     summary = write_report(paths, out, medium=medium, eps_interval=interval, false_alarm=fa,
                            kinds=ks, z=zs, hologram=hologram, title=title, force=force,
                            layout=layout, check=check, names=_NAMES, min_cover=min_cover,
-                           meta=fields)
+                           meta=fields, progress=report.progress)
     lines = []
     for s in summary["sources"]:
         lines.append(f"{s['name']}: {s['n_objects']} object(s)"
