@@ -54,6 +54,7 @@ SPARSE_VOXELS = 3_000_000   # voxel-frequencies up to which the sparse method is
 GRID_CELLS = 0.5            # the inversion grid's pixel, in lateral resolution cells
 MAX_ITER = 300              # the sparse solver's steps in detect
 PROBE_ITER = 100            # its steps where the first fit only measures the noise
+LSQR_PROBE_ITER = 30        # least squares' steps for that (it converges in tens)
 #: A weaker object within a resolution cell of a stronger one by more than this (the
 #: energy, dB) is a fragment of it: the aperture's first sidelobe level.
 FRAGMENT_DB = -13.3
@@ -85,24 +86,25 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         # otherwise its planes and pixels say nothing of where the inversion looks.
         model = HologramModel(hologram, vol, medium, dict(options))
         model.start()
-    n_vox = vol.z.size * len(grid.get("y", vol.y)) * len(grid.get("x", vol.x))
+    rcell = _range_cell(hologram, medium, float(np.median(vol.z)))
+    planes = _planes(vol.z, rcell if hologram.nf > 1 else 0.0)
+    n_vox = planes.size * len(grid.get("y", vol.y)) * len(grid.get("x", vol.x))
     method = "sparse" if n_vox * hologram.nf <= SPARSE_VOXELS else "lsqr"
     cell = _lateral_cell(hologram, medium, float(np.median(vol.z)))
-    n_cells = max(1.0, (np.ptp(vol.x) * np.ptp(vol.y)) / cell**2) * vol.z.size
+    n_cells = max(1.0, (np.ptp(vol.x) * np.ptp(vol.y)) / cell**2) * planes.size
     p = min(0.5, false_alarm * n_cells)
-    zs = vol.z if not vol.planar else float(vol.z[0])
+    zs = planes if not vol.planar else float(vol.z[0])
     if not hologram.monostatic and hologram.source is None:
         # The source unknown: its illumination taken as uniform (each object's amplitude
         # then carries it), said in the table's attributes.
         grid["illumination"] = "none"
-    rcell = _range_cell(hologram, medium, float(np.median(vol.z)))
     # Single precision: its relative 1e-7 lies far below any noise the threshold
     # admits, and halves the memory each of the solver's hundreds of steps moves.
     grid.setdefault("dtype", np.complex64)
 
-    def invert(sigma: float | None, steps: int) -> Any:
+    def invert(sigma: float | None, steps: int | None) -> Any:
         return reflectivity(hologram, zs, medium=medium, method=method, progress=progress,
-                            max_iter=steps if method == "sparse" else None,
+                            max_iter=steps,
                             false_alarm=p, need_source=False, noise=sigma, **grid)
 
     from ...imaging.inversion.noise import noise_std
@@ -113,7 +115,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     assumed = how.startswith("assumed")
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always", NoiseWarning)
-        res = invert(noise, PROBE_ITER if assumed else MAX_ITER)
+        res = invert(noise, (PROBE_ITER if assumed else MAX_ITER) if method == "sparse"
+                     else (LSQR_PROBE_ITER if assumed else None))
     if assumed:
         # The noise could not be estimated and was assumed: what a first fit leaves of
         # the data, noise and the model's error together, is a noise no lower than the
@@ -122,7 +125,7 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
         # (a noise set too low is fitted, and spurious pieces follow).
         step = res.image.history[0]
         sigma = max(res.sigma, step["residual"] / math.sqrt(hologram.data.size))
-        res = res.again(sigma) if method == "sparse" else invert(sigma, MAX_ITER)
+        res = res.again(sigma) if method == "sparse" else invert(sigma, None)
         res.image.history[0]["noise"] = ("the residual of a first inversion with the "
                                          "noise assumed 40 dB below the data's power")
     for w in said:
@@ -160,6 +163,20 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
             "illumination": grid.get("illumination", "field"),
             "model_error_floor": float(floor)}
     return rows, meta
+
+
+def _planes(z: np.ndarray, range_cell: float) -> np.ndarray:
+    """The image's planes the inversion is solved on: across a band, every plane up to
+    :data:`GRID_CELLS` of a range cell apart, more finely sampled ones thinned to that
+    (a range cell holds one independent voxel in range; finer planes make nearly
+    parallel columns, which cost steps and spread an object over them), the first and
+    the last kept; one frequency (``range_cell`` 0): every plane."""
+    z = np.atleast_1d(np.asarray(z, float))
+    if z.size < 3 or not range_cell > 0:
+        return z
+    step = max(1, math.floor(GRID_CELLS * range_cell / float(np.min(np.diff(z)))))
+    keep = np.unique(np.r_[np.arange(0, z.size, step), z.size - 1])
+    return z[keep]
 
 
 def _floor(threshold: float, residual: float, noise_norm: float) -> float:
