@@ -84,8 +84,11 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
     args = dict(args)
     shown = args.pop("progress", None)
     args["progress"] = False
+    import sys
+
+    # None: after a second of work, on a terminal only (a bar in a log is noise).
     with tqdm(total=len(frames), desc="detect (frames)", unit="frame", delay=1.0,
-              disable=shown is False) as bar:
+              disable=shown is False or (shown is None and not sys.stderr.isatty())) as bar:
         for i in frames:
             df = _frame_objects(path, i, idx, settings, holograms.get(i), plane, args)
             tables.append(df)

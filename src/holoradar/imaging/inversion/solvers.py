@@ -56,11 +56,15 @@ class Solution:
 
 
 def _bar(progress: Any, total: int, desc: str) -> Any:
-    """A bar over the solver's steps, shown once the work has lasted a second (never with
-    ``progress=False``)."""
+    """A bar over the solver's steps, shown once the work has lasted a second: with
+    ``progress=None`` on a terminal only (in a pipe or a log a bar is lines of noise),
+    never with ``progress=False``."""
+    import sys
+
     from tqdm.auto import tqdm  # here, not at import: holoradar._lazy
 
-    return tqdm(total=total, desc=desc, unit="step", disable=progress is False, delay=1.0)
+    hidden = progress is False or (progress is None and not sys.stderr.isatty())
+    return tqdm(total=total, desc=desc, unit="step", disable=hidden, delay=1.0)
 
 
 def least_squares(A: Any, d: np.ndarray, sigma: float, c: np.ndarray, max_iter: int,
