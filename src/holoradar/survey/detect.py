@@ -159,11 +159,26 @@ def _frame_objects(path: Path, i: int, idx: dict[str, Any], settings: Any, holo:
         shift = (0.0, 0.0)
     df = to_survey(df, shift)
     # Each frame reports the objects under its array: one beyond it is seen from the
-    # side, fitted poorly, and left to the frame above it.
+    # side, fitted poorly, and left to the frame above it ...
     outlines = df.attrs.get("outlines") or {}
     df["_outline"] = pd.Series([outlines.get(n) for n in range(len(df))], index=df.index,
                                dtype=object)
     under = df["x"].between(img.x[0], img.x[-1]) & df["y"].between(img.y[0], img.y[-1])
+    # ... and of those the ones nearer its centre than any other finished frame's: near
+    # the array's edge an object beside it (seen from the side, beyond the image) leaves
+    # pieces at the edge, where a neighbour sees the same place from above. A bar
+    # crossing the frames lies near each frame's centre and is kept by each.
+    done = np.flatnonzero(idx["done"])
+    fx, fy = idx["frame_x"][done], idx["frame_y"][done]
+    own = np.hypot(df["x"].to_numpy() - idx["frame_x"][i], df["y"].to_numpy()
+                   - idx["frame_y"][i])
+    if len(df) and done.size > 1:
+        best = np.min(np.hypot(df["x"].to_numpy()[:, None] - fx[None],
+                               df["y"].to_numpy()[:, None] - fy[None]), axis=1)
+        # within half a cell of the boundary both frames keep it (the merge joins
+        # them): a bar midway between two centres is not lost to the scatter of both
+        # positions
+        under &= own <= best + 0.5 * max(df.attrs["resolution_cell"][:2])
     df = df[under].reset_index(drop=True)
     df["frame"] = name
     df["_off"] = np.hypot(df["x"] - idx["frame_x"][i], df["y"] - idx["frame_y"][i])

@@ -63,6 +63,9 @@ FRAGMENT_DB = -13.3
 #: differ from its points by 5-15 % in amplitude, and the sparse fit spreads that
 #: difference over voxels up to about -18 dB of the object that causes it.
 DYNAMIC_RANGE_DB = -22.0
+#: The operator's model error of a real object, in amplitude: full-wave objects differ
+#: from its points by 5-15 % (cylinders, plates, spheres against the fixtures).
+MODEL_ERROR = 0.15
 
 
 def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any],
@@ -136,7 +139,6 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     c = res.column_norms.reshape(data.shape)
     energy = (np.abs(data) * c) ** 2
     step = r.history[0]
-    floor = _floor(res.threshold, step["residual"], step["noise_norm"])
     # The sparse solution's voxels each passed the threshold on their correlation with
     # the data (the soft threshold then shrank them by it); least squares' are kept
     # where they stand above it.
@@ -146,6 +148,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     # floor holds for the whole bar, not for each piece.
     objects = _join_collinear(_objects(data, support, r, cell, rcell, c), cell, rcell)
     objects = _join_collinear(_merge_fragments(objects, cell, rcell), cell, rcell)
+    floor = _floor(res.threshold, step["residual"], step["noise_norm"],
+                   sum(_energy(ob) for ob in objects))
     objects = [ob for ob in objects if _energy(ob) > floor]
     if objects:
         top = max(float(ob["w"].max()) for ob in objects)
@@ -179,12 +183,17 @@ def _planes(z: np.ndarray, range_cell: float) -> np.ndarray:
     return z[keep]
 
 
-def _floor(threshold: float, residual: float, noise_norm: float) -> float:
+def _floor(threshold: float, residual: float, noise_norm: float, found: float) -> float:
     """The energy ``sum_j |r_j c_j|^2`` an object needs: above the noise's threshold
     squared, and above what the fit leaves unexplained beyond the noise,
     ``|A r - d|^2 - M sigma^2`` (the model's error: the sparse fit explains part of it
-    by small spurious objects, each weaker than what it leaves)."""
-    return max(threshold**2, residual**2 - noise_norm**2)
+    by small spurious objects, each weaker than what it leaves) -- but not above the
+    model's error of what was found, :data:`MODEL_ERROR` squared times the objects'
+    energy ``found``: the rest of the residual is what the grid cannot hold (objects
+    beside the frame's field of view, whose echoes the elements record) or what the
+    steps have not reached yet, and neither makes objects on the grid."""
+    unexplained = residual**2 - noise_norm**2
+    return max(threshold**2, min(unexplained, MODEL_ERROR**2 * found))
 
 
 def _grid(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any]
