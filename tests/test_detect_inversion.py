@@ -185,3 +185,18 @@ def test_cli_searches_a_wideband_volume_without_its_hologram_as_the_library(mat_
     ref = hr.detect(hr.load(image), medium=conc)
     assert got["n_objects"] == len(ref)
     assert got["metadata"]["model"] == ref.attrs["model"] == "window, by planes"
+
+
+def test_the_floor_is_the_model_error_of_what_was_found_at_most():
+    # What the fit leaves beyond the noise bounds a spurious object's energy, but an
+    # echo from beside the grid (which no voxel can explain) leaves more than the
+    # model's error of the objects found, MODEL_ERROR^2 of their energy, can make.
+    from holoradar.analysis.detect.reflectivity import MODEL_ERROR, _floor
+
+    # a residual of model error only: its energy beyond the noise
+    assert _floor(0.01, residual=0.2, noise_norm=0.1, found=10.0) == pytest.approx(0.03)
+    # a residual far above what the found objects' error can be: capped there
+    assert _floor(0.01, residual=3.0, noise_norm=0.1, found=1.0) == \
+        pytest.approx(MODEL_ERROR**2)
+    # never below the noise's threshold squared
+    assert _floor(0.5, residual=0.1, noise_norm=0.1, found=1.0) == pytest.approx(0.25)
