@@ -23,6 +23,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from ._version import __version__
     from .analysis.detect import detect, rebar_layers, unbiased_peak
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
+    from .data.grid_axes import CoordinateWarning
     from .data.hologram import C0, Hologram, Image
     from .data.pose import Pose
     from .data.wideband import apply_calibration, conjugate, remove_mean
@@ -63,6 +64,7 @@ _NAMES = {
     "Aperture": ".model.scene",
     "AutofocusResult": ".imaging.autofocus",
     "C0": ".data.hologram",
+    "CoordinateWarning": ".data.grid_axes",
     "Dipole": ".physics.dipole",
     "FitWarning": ".imaging.glare",
     "Fresnel": ".physics.propagation",
@@ -132,6 +134,7 @@ __all__ = [
     "AngularSpectrum",
     "Aperture",
     "AutofocusResult",
+    "CoordinateWarning",
     "Dipole",
     "FitWarning",
     "Fresnel",

@@ -70,7 +70,8 @@ def as_axis(values: object, name: str, *, length: int | None = None) -> np.ndarr
     if length is not None and arr.size != length:
         raise ValueError(f"{name} must have {length} values to match the data, got {arr.size}")
     if arr.size > 1 and np.any(np.diff(arr) <= 0):
-        raise ValueError(f"{name} must be strictly increasing")
+        raise ValueError(f"{name} must be strictly increasing (sort the samples by it; a "
+                         "hologram reverses an axis written from its high end with its data)")
     return arr
 
 

@@ -94,6 +94,10 @@ class Hologram:
                  source: Any = None, monostatic: bool = False,
                  pose: Pose | None = None, polarization: Any = None) -> None:
         arr = as_finite_complex(data, "data", min_ndim=2)
+        # A reversed axis, or one rounded to a text export's digits: made increasing
+        # and uniform, said once (data/grid_axes.py).
+        x, arr = _regular(x, arr, "x", -1)
+        y, arr = _regular(y, arr, "y", -2)
         xa = as_axis(x, "x", length=arr.shape[-1])
         ya = as_axis(y, "y", length=arr.shape[-2])
         f = frequency_axis(frequency, arr.shape)
@@ -373,3 +377,17 @@ class Image:
             return self
         i = int(np.argmin(np.abs(self.z - z)))
         return replace(self, data=self.data[..., i, :, :], z=self.z[i:i + 1], has_z_axis=False)
+
+
+def _regular(values: Any, data: np.ndarray, name: str, axis: int) -> tuple[Any, np.ndarray]:
+    """:func:`~.grid_axes.regular_axis` where the coordinates are a finite 1-D axis of the
+    data's length; anything else as given (``as_axis`` says what is wrong with it)."""
+    from .grid_axes import regular_axis
+
+    try:
+        v = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        return values, data
+    if v.ndim != 1 or v.size != data.shape[axis] or not np.all(np.isfinite(v)):
+        return values, data
+    return regular_axis(v, data, name, axis)
