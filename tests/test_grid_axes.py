@@ -63,5 +63,5 @@ def test_coordinates_off_their_grid_are_not_snapped():
 def test_an_unordered_axis_is_refused_with_the_way_out():
     x = np.arange(8) * 0.01
     x[[2, 3]] = x[[3, 2]]
-    with pytest.raises(ValueError, match="strictly increasing .*sort the samples"):
+    with pytest.raises(ValueError, match=r"strictly increasing .*sort the samples"):
         hr.Hologram(np.ones((8, 8)), x, np.arange(8) * 0.01, 10e9)

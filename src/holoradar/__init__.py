@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from .imaging.migrate import IlluminationWarning, migrate
     from .imaging.migration.linear import MigrationOperator, migration_operator
     from .imaging.migration.settings import MigrationSettings
+    from .imaging.propagate import propagate
     from .imaging.stream import StreamImager
     from .imaging.synthesis import align_phases, synthesize
     from .io import load, save
@@ -103,6 +104,7 @@ _NAMES = {
     "migrate": ".imaging.migrate",
     "migration_operator": ".imaging.migration.linear",
     "permittivity": ".physics.medium",
+    "propagate": ".imaging.propagate",
     "plan_oblique": ".analysis.oblique_plan",
     "remove_mean": ".data.wideband",
     "report": ".reporting",
@@ -174,6 +176,7 @@ __all__ = [
     "migration_operator",
     "permittivity",
     "plan_oblique",
+    "propagate",
     "rebar_layers",
     "remove_mean",
     "report",
