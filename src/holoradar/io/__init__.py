@@ -148,6 +148,9 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             obj = None
         if obj is None and _is_holoradar_netcdf(src):
             obj = _load_netcdf(src)  # ours but odd: the xarray reader names the problem
+    if obj is None and lay is not None and lay.wide is not None:
+        obj = _wide(src, lay)
+        device = "iq_sign" not in lay.given
     if obj is None:
         variables = read_variables(src)
         sidecar = src.with_suffix(".json")
@@ -175,6 +178,23 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
 
 _IQ_FIX = ("declare it in the layout, iq_sign=I-iQ (holoradar --layout '...,iq_sign=I-iQ', "
            "hr.load(path, layout='...,iq_sign=I-iQ')), or image hr.conjugate(hologram)")
+
+
+def _wide(src: Path, lay: Layout) -> Hologram:
+    """A scanner's wide text table (:mod:`holoradar.io.wide`) gathered into a hologram."""
+    from dataclasses import replace
+
+    from .wide import read_wide
+
+    if not src.is_file():
+        raise ValueError(f"path {str(src)!r} is not a file")
+    unit = lay.frequency_unit if "frequency_unit" in lay.given else None
+    variables, _ = read_wide(src, unit, lay.wide)
+    pair = {"i": "I", "q": "Q"} if lay.wide == "reim" else {"amplitude": "amplitude",
+                                                           "phase": "phase"}
+    full = replace(lay, wide=None, x="x", y="y", frequency="frequency", frequency_unit="Hz",
+                   data=None, **pair)
+    return assemble(variables, full, what=src.name)
 
 
 def _npz_image(v: dict[str, np.ndarray], what: str) -> Image:

@@ -85,6 +85,12 @@ class Layout:
         ``"I-iQ"``: the device records the conjugate (conjugated on reading).
     monostatic : bool
         A scanned transceiver (see :class:`~holoradar.Hologram`).
+    wide : {"reim", "magphase"}, optional
+        A scanner's wide text table (any suffix): after metadata lines, a header
+        row naming the coordinates (``X``, ``Y``) and each frequency twice, then one
+        row per point with each frequency's real and imaginary parts (or magnitude
+        and phase) (:mod:`holoradar.io.wide`). The bare word ``wide`` in the text
+        form is ``wide=reim``.
 
     Examples
     --------
@@ -107,6 +113,7 @@ class Layout:
     phase_unit: str = "rad"
     iq_sign: str = "I+iQ"
     monostatic: bool = False
+    wide: str | None = None
     given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
     """The keys set explicitly (by :meth:`from_mapping`): they win in :meth:`merged`
     even where they equal the default."""
@@ -155,6 +162,9 @@ class Layout:
                                  f"number(s), got {f!r}")
         if not isinstance(self.monostatic, bool):
             raise ValueError(f"layout monostatic must be true or false, got {self.monostatic!r}")
+        if self.wide not in (None, "reim", "magphase"):
+            raise ValueError("layout wide must be 'reim' (each frequency's real and imaginary "
+                             f"parts) or 'magphase', got {self.wide!r}")
 
     @classmethod
     def from_mapping(cls, mapping: Mapping[str, Any], what: str = "layout") -> Layout:
@@ -173,6 +183,11 @@ class Layout:
                              "(and units)")
         if isinstance(m.get("frequency"), list):
             m["frequency"] = tuple(m["frequency"])
+        if m.get("wide") is True or (isinstance(m.get("wide"), str)
+                                     and m["wide"].lower() in ("true", "yes", "1")):
+            m["wide"] = "reim"
+        elif m.get("wide") is False:
+            m["wide"] = None
         try:
             return cls(**m, given=frozenset(m))
         except TypeError as exc:
@@ -191,8 +206,12 @@ class Layout:
             if not part.strip():
                 continue
             key, sep, value = part.partition("=")
+            if not sep and key.strip() == "wide":
+                m["wide"] = "reim"          # the bare word: a wide table of Re, Im
+                continue
             if not sep:
-                raise ValueError(f"layout entries are key=value, got {part.strip()!r}")
+                raise ValueError(f"layout entries are key=value (or the word wide), got "
+                                 f"{part.strip()!r}")
             key, value = key.strip(), value.strip()
             if key in ("pitch", "frequency") and _is_number(value):
                 m[key] = float(value)

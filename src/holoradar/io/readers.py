@@ -482,7 +482,9 @@ def read_variables(path: str | Path) -> dict[str, np.ndarray]:
     reader = READERS.get(src.suffix.lower())
     if reader is None:
         raise ValueError(f"path {src.name!r}: unknown format {src.suffix!r}; holoradar reads "
-                         f"{', '.join(sorted(READERS))}")
+                         f"{', '.join(sorted(READERS))}, and a scanner's wide text table of "
+                         "any suffix with layout 'wide,...' (a header row naming X, Y and "
+                         "each frequency twice)")
     if not src.is_file():
         raise ValueError(f"path {str(src)!r} is not a file")
     if src.stat().st_size == 0:

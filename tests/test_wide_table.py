@@ -1,0 +1,88 @@
+"""Scanner exports as they come: a wide text table (metadata lines, a header naming X, Y
+and each frequency twice, one row per point), coordinates written to four decimals in
+mm, an I - jQ device; read by hr.load with a layout, on the command line too."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import holoradar as hr
+from cli_helpers import one_line_error, run
+
+X_MM = (np.arange(16) - 7.5) * 35 / 6          # 5.8333 mm pitch, -43.75 ... 43.75
+F_GHZ = (8.2, 9.1, 10.0)
+
+
+def _field(f_ghz: float) -> np.ndarray:
+    """A point 20 cm below the plane, its field under exp(-i omega t): (ny, nx)."""
+    k = 2 * np.pi * f_ghz * 1e9 / hr.C0
+    xx, yy = np.meshgrid(X_MM * 1e-3, X_MM * 1e-3)
+    r = np.sqrt(xx**2 + yy**2 + 0.2**2)
+    return np.exp(1j * k * r) / r
+
+
+def _export(path, *, conj=True, header=None, extra_z=False, meta=33):
+    """The scanner's export: ``meta`` metadata lines, the header, a row per point (index,
+    X, Y, Z in mm to four decimals, then Re, Im per frequency of the device's I - jQ)."""
+    lines = [f"Meta {i}: value {i}" for i in range(meta)]
+    lines.append(header or "Frequency, X, Y, Z, " + ", ".join(f"{f}, {f}" for f in F_GHZ))
+    fields = [np.conj(_field(f)) if conj else _field(f) for f in F_GHZ]
+    n = 0
+    for iy, y in enumerate(X_MM):
+        for ix, x in enumerate(X_MM):
+            z = 110.0 if extra_z and n == 3 else 100.0
+            vals = ", ".join(f"{v[iy, ix].real:.9g}, {v[iy, ix].imag:.9g}" for v in fields)
+            lines.append(f"{n + 1}, {x:.4f}, {y:.4f}, {z:.1f}, {vals}")
+            n += 1
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def test_a_scanners_export_is_read_by_its_layout(tmp_path):
+    p = _export(tmp_path / "plane.txt")
+    with pytest.warns(hr.CoordinateWarning, match="snapped"):
+        h = hr.load(p, layout="wide,units=mm,iq_sign=I-iQ")
+    assert h.data.shape == (3, 16, 16)
+    np.testing.assert_allclose(h.frequencies, np.array(F_GHZ) * 1e9)
+    # the least-squares pitch of coordinates each off by up to 5e-8 m (four decimals
+    # in mm): off by at most 2 x 5e-8 m over the 87.5 mm span, relative 1.2e-6
+    assert h.pitch[0] == pytest.approx(35e-3 / 6, rel=1.2e-6)
+    # the conjugate undone, each sample as written (nine digits)
+    for i, f in enumerate(F_GHZ):
+        np.testing.assert_allclose(h.data[i], _field(f), rtol=1e-8)
+
+
+def test_the_command_line_reads_it_with_layout(tmp_path):
+    p = _export(tmp_path / "plane.dat")
+    res = run("info", p, "--layout", "wide,units=mm,iq_sign=I-iQ", "--json")
+    # the coordinates' snapping is said on stderr; the summary is the JSON line
+    info = json.loads(res.output[res.output.index("{\n"):])
+    got = info["readable_as"]
+    assert got["kind"] == "Hologram" and got["shape"] == [3, 16, 16]
+    assert got["frequency_hz"] == [8.2e9, 9.1e9, 10e9]
+
+
+@pytest.mark.parametrize(("kwargs", "layout", "needle"), [
+    ({"header": "Frequency, X, Y, Z, 8.2, 9.1, 10.0, 10.0, 11, 11"}, "wide",
+     "each frequency twice"),
+    ({"extra_z": True}, "wide,units=mm", "holds 2 planes"),
+    # 500-700: GHz or MHz would both be radar frequencies
+    ({"header": "Frequency, X, Y, Z, 500, 500, 600, 600, 700, 700"}, "wide,units=mm",
+     "frequency_unit=GHz"),
+    ({"header": "index, a, b, c, 8.2, 8.2, 9.1, 9.1, 10, 10"}, "wide", "no header row"),
+    ({"header": "Frequency, X, Y, 8.2, 8.2, 9.1, 9.1, 10, 10"}, "wide", "line 35"),
+])
+def test_bad_tables_are_refused_by_what_is_wrong(tmp_path, kwargs, layout, needle):
+    p = _export(tmp_path / "bad.txt", **kwargs)
+    with pytest.raises(ValueError, match=needle):
+        hr.load(p, layout=layout)
+
+
+def test_a_text_table_without_the_wide_layout_says_how(tmp_path):
+    p = _export(tmp_path / "plane.txt")
+    with pytest.raises(ValueError, match=r"layout 'wide,\.\.\.'"):
+        hr.load(p)
+    one_line_error(run("info", p, ok=False), "wide")
