@@ -86,3 +86,24 @@ def test_a_text_table_without_the_wide_layout_says_how(tmp_path):
     with pytest.raises(ValueError, match=r"layout 'wide,\.\.\.'"):
         hr.load(p)
     one_line_error(run("info", p, ok=False), "wide")
+
+
+def test_a_matlab_struct_is_read_by_its_fields(tmp_path):
+    # An inverse-SAR export: data.measurements (x, y, f in MATLAB's order, data(iy, ix, if))
+    # with data.x, data.y (m) and data.f (Hz) beside it. The layout names the fields;
+    # a field that does not exist is refused with the fields there are.
+    from scipy.io import savemat
+
+    x = (np.arange(12) - 5.5) * 0.018
+    f = np.linspace(5.7e9, 8.2e9, 5)
+    meas = (np.arange(12 * 12 * 5).reshape(12, 12, 5) + 1j).astype(complex)
+    p = tmp_path / "tape.mat"
+    savemat(p, {"data": {"measurements": meas, "x": x, "y": x, "f": f,
+                         "note": "copper tape"}})
+    h = hr.load(p, layout="data=data.measurements, x=data.x, y=data.y, frequency=data.f, "
+                          "axes=yxf, iq_sign=I+iQ", check=False)
+    assert h.data.shape == (5, 12, 12)
+    np.testing.assert_array_equal(h.data[2], meas[:, :, 2])
+    with pytest.raises(ValueError, match=r"data\.measurement\b.*data\.measurements"):
+        hr.load(p, layout="data=data.measurement, x=data.x, y=data.y, frequency=data.f",
+                check=False)

@@ -145,18 +145,39 @@ def read_mat(path: Path) -> dict[str, np.ndarray]:
                     f"variable {name!r} in {path.name}")
     raw = loadmat(path, squeeze_me=False, mat_dtype=False, chars_as_strings=True)
     out: dict[str, np.ndarray] = {}
+    other: list[str] = []
     for name, value in raw.items():
-        if name.startswith("__"):
-            continue
-        arr = np.asarray(value) if isinstance(value, np.ndarray) else None
-        if arr is not None and arr.dtype.kind in "biufc":
-            out[name] = np.array(arr)
-        elif arr is not None and arr.dtype.kind == "U" and arr.size == 1:  # a char array
-            out[name] = np.array(str(arr.reshape(()).item())[:256])
-        else:
-            out.setdefault("__other__", np.array([], dtype="U1"))
-            out["__other__"] = np.append(out["__other__"], name)
+        if not name.startswith("__"):
+            _mat_value(name, value, out, other, 0)
+    if other:
+        out["__other__"] = np.array(other)
     return out
+
+
+def _mat_value(name: str, value: Any, out: dict[str, np.ndarray], other: list[str],
+               depth: int) -> None:
+    """One MATLAB value: a number array as ``name``; a 1 x 1 struct's fields as
+    ``name.field`` (nested structs likewise, four levels at most); anything else listed
+    in ``other`` by what it is."""
+    arr = np.asarray(value) if isinstance(value, np.ndarray) else None
+    if arr is not None and arr.dtype.kind in "biufc":
+        out[name] = np.array(arr)
+    elif arr is not None and arr.dtype.kind == "U" and arr.size == 1:  # a char array
+        out[name] = np.array(str(arr.reshape(()).item())[:256])
+    elif arr is not None and arr.dtype.names and arr.size == 1 and depth < 4:
+        rec = arr.reshape(-1)[0]
+        for field in arr.dtype.names:
+            inner = rec[field]
+            # loadmat wraps each field in an object array of one element
+            if isinstance(inner, np.ndarray) and inner.dtype == object and inner.size == 1:
+                inner = inner.reshape(-1)[0]
+            _mat_value(f"{name}.{field}", inner, out, other, depth + 1)
+    elif arr is not None and arr.dtype.names:
+        other.append(f"{name} (a struct array of {arr.size}: fields "
+                     f"{', '.join(arr.dtype.names)})")
+    else:
+        what = "a cell" if arr is not None and arr.dtype == object else "not numeric"
+        other.append(f"{name} ({what})")
 
 
 def _from_compound(arr: np.ndarray) -> np.ndarray | None:
