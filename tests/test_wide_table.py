@@ -107,3 +107,12 @@ def test_a_matlab_struct_is_read_by_its_fields(tmp_path):
     with pytest.raises(ValueError, match=r"data\.measurement\b.*data\.measurements"):
         hr.load(p, layout="data=data.measurement, x=data.x, y=data.y, frequency=data.f",
                 check=False)
+
+
+def test_a_frequency_list_in_the_layout_text():
+    from holoradar.io.layout import Layout
+
+    assert Layout.parse("data=E, frequency=[8.2, 9.1 10], frequency_unit=GHz").frequency \
+        == (8.2, 9.1, 10.0)
+    with pytest.raises(ValueError, match=r"a list of numbers such as \[8\.2"):
+        Layout.parse("frequency=[8.2, x]")

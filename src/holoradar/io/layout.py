@@ -197,8 +197,9 @@ class Layout:
     def parse(cls, text: str) -> Layout:
         """A layout from ``key=value`` pairs separated by commas (the command line's form).
 
-        Numbers are read for ``pitch`` and ``frequency`` (``frequency=9.9`` or a
-        variable name); ``monostatic=true``. A comma inside ``[...]`` does not
+        Numbers are read for ``pitch`` and ``frequency`` (``frequency=9.9``, a list
+        ``frequency=[8.2, 9.1, 10]``, or a variable name); ``monostatic=true``; the
+        bare word ``wide``. A comma inside ``[...]`` does not
         split.
         """
         m: dict[str, Any] = {}
@@ -215,6 +216,13 @@ class Layout:
             key, value = key.strip(), value.strip()
             if key in ("pitch", "frequency") and _is_number(value):
                 m[key] = float(value)
+            elif key == "frequency" and value.startswith("[") and value.endswith("]"):
+                # a list: frequency=[8.2, 9.1, 10.0] (commas or spaces between)
+                items = [v for v in re.split(r"[,\s]+", value[1:-1]) if v]
+                if not items or not all(_is_number(v) for v in items):
+                    raise ValueError("layout frequency must be a number, a list of numbers "
+                                     f"such as [8.2, 9.1, 10] or a variable name, got {value!r}")
+                m[key] = tuple(float(v) for v in items)
             elif key == "monostatic":
                 if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
                     raise ValueError(f"layout monostatic must be true or false, got {value!r}")
