@@ -81,11 +81,14 @@ class IQSignCheck:
         << 1 for ``I - iQ``.
     z : tuple of float
         The ranges imaged, metres.
+    reason : str
+        Why there is no verdict (empty with one): what the check saw, and what to try.
     """
 
     sign: Literal["I+iQ", "I-iQ"] | None
     ratio: float
     z: tuple[float, ...]
+    reason: str = ""
 
 
 def _sharpness(data: np.ndarray) -> float:
@@ -220,17 +223,25 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
                                   progress=False, **opts)
                 total = total + np.abs(img.data) ** 2
             sides.append(_sharpness(np.sqrt(total)))
-    except ValueError:  # a grid or geometry the imaging refuses: no verdict
-        return IQSignCheck(None, float("nan"), ())
+    except ValueError as exc:  # a grid or geometry the imaging refuses: no verdict
+        return IQSignCheck(None, float("nan"), (), f"the hologram cannot be imaged so: {exc}")
+    planes = tuple(float(v) for v in zs)
     if not (sides[0] > 0 and sides[1] > 0):  # data all zero: nothing to compare
-        return IQSignCheck(None, float("nan"), tuple(float(v) for v in zs))
+        return IQSignCheck(None, float("nan"), planes, "the data are zero")
     ratio = sides[0] / sides[1]
     sign: Literal["I+iQ", "I-iQ"] | None = None
     if ratio >= DECISIVE_RATIO:
         sign = "I+iQ"
     elif ratio <= 1 / DECISIVE_RATIO:
         sign = "I-iQ"
-    return IQSignCheck(sign, float(ratio), tuple(float(v) for v in zs))
+    why = "" if sign is not None else (
+        f"the data and their conjugate focus alike at {min(planes):.3g} to {max(planes):.3g} m "
+        f"(sharpness ratio {ratio:.2f}, a verdict needs {DECISIVE_RATIO:g} or "
+        f"1/{DECISIVE_RATIO:g}): nothing compact there, each of "
+        f"{min(hologram.nf, MAX_FREQUENCIES)} frequencies judged alone; give z where a "
+        "compact reflector (or the radiating antenna) lies, or compare the band's "
+        "coherent foci at those ranges with iq_convention(hologram, z)")
+    return IQSignCheck(sign, float(ratio), planes, why)
 
 
 def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
@@ -262,8 +273,14 @@ def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
     >>> iq_convention(h, [0.18, 0.2, 0.22]), iq_convention(conjugate(h), [0.18, 0.2, 0.22])
     ('I+iQ', 'I-iQ')
     """
-    as_is = _sharpness(migrate(hologram, z, **migrate_options).data)
-    flipped = _sharpness(migrate(conjugate(hologram), z, **migrate_options).data)
+    from .migrate import IlluminationWarning
+
+    with warnings.catch_warnings():
+        # Both images assume the same illumination where the source is not given: the
+        # comparison does not depend on it, and nothing was asked about it.
+        warnings.simplefilter("ignore", IlluminationWarning)
+        as_is = _sharpness(migrate(hologram, z, **migrate_options).data)
+        flipped = _sharpness(migrate(conjugate(hologram), z, **migrate_options).data)
     return "I+iQ" if as_is >= flipped else "I-iQ"
 
 
