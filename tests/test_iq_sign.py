@@ -189,16 +189,12 @@ def test_an_undecided_check_says_why_and_iq_convention_warns_of_nothing_it_was_n
     # Noise alone focuses nowhere: no verdict, and the reason names the ranges, the
     # ratio and the way on. iq_convention across a band without a source combines the
     # frequencies for both images alike: no IlluminationWarning about it.
-    import warnings as _w
-
-    import holoradar as hr
-
     rng = np.random.default_rng(3)
     x = (np.arange(24) - 11.5) * 0.0125
     f = [9e9, 10e9, 11e9]
     h = hr.Hologram(rng.normal(size=(3, 24, 24)) + 1j * rng.normal(size=(3, 24, 24)), x, x, f)
     r = hr.check_iq_sign(h, [0.2, 0.3])
     assert r.sign is None and "focus alike" in r.reason and "iq_convention" in r.reason
-    with _w.catch_warnings():
-        _w.simplefilter("error", hr.IlluminationWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", hr.IlluminationWarning)
         hr.iq_convention(h, [0.2, 0.3])

@@ -141,7 +141,8 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     lay = _as_layout(layout)
     obj = None
     device = False
-    if src.suffix.lower() in NETCDF_SUFFIXES and lay is None:
+    # holoradar's own file: its layout is its own (a response table still applies)
+    if src.suffix.lower() in NETCDF_SUFFIXES and (lay is None or lay.given <= {"response"}):
         try:  # holoradar's own file, read in one pass (a survey reads thousands)
             obj = read_direct(src)
         except Exception:  # not ours, or damaged: decided below
@@ -165,6 +166,11 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             full = (side_layout or Layout()).merged(lay)
             obj = assemble(variables, full, what=src.name)
             device = "iq_sign" not in full.given
+    response = _response(lay, src)
+    if response is not None and isinstance(obj, Hologram):
+        from .response import apply_response
+
+        obj = apply_response(obj, response)
     if check and isinstance(obj, Hologram):
         check_plausible(obj, what=src.name)
         if device and iq_check:
@@ -178,6 +184,17 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
 
 _IQ_FIX = ("declare it in the layout, iq_sign=I-iQ (holoradar --layout '...,iq_sign=I-iQ', "
            "hr.load(path, layout='...,iq_sign=I-iQ')), or image hr.conjugate(hologram)")
+
+
+def _response(lay: Layout | None, src: Path) -> Path | None:
+    """The layout's response table, a path relative to the data file's folder."""
+    if lay is None or lay.response is None:
+        return None
+    p = Path(lay.response)
+    p = p if p.is_absolute() or p.exists() else src.parent / p
+    if not p.is_file():
+        raise ValueError(f"layout response: {lay.response!r} is not a file")
+    return p
 
 
 def _wide(src: Path, lay: Layout) -> Hologram:

@@ -91,6 +91,10 @@ class Layout:
         row per point with each frequency's real and imaginary parts (or magnitude
         and phase) (:mod:`holoradar.io.wide`). The bare word ``wide`` in the text
         form is ``wide=reim``.
+    response : str, optional
+        A table of the device's complex response per frequency (a CSV file:
+        ``frequency`` and ``re``/``im`` or ``amplitude``/``phase``): each frequency is
+        divided by it on reading (:mod:`holoradar.io.response`).
 
     Examples
     --------
@@ -114,6 +118,7 @@ class Layout:
     iq_sign: str = "I+iQ"
     monostatic: bool = False
     wide: str | None = None
+    response: str | None = None
     given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
     """The keys set explicitly (by :meth:`from_mapping`): they win in :meth:`merged`
     even where they equal the default."""
@@ -162,6 +167,9 @@ class Layout:
                                  f"number(s), got {f!r}")
         if not isinstance(self.monostatic, bool):
             raise ValueError(f"layout monostatic must be true or false, got {self.monostatic!r}")
+        if self.response is not None and (not isinstance(self.response, str)
+                                          or not self.response.strip()):
+            raise ValueError(f"layout response must be a file's path, got {self.response!r}")
         if self.wide not in (None, "reim", "magphase"):
             raise ValueError("layout wide must be 'reim' (each frequency's real and imaginary "
                              f"parts) or 'magphase', got {self.wide!r}")

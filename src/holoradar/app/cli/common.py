@@ -124,8 +124,30 @@ def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
     @click.option("--no-check", is_flag=True,
                   help="Skip the plausibility checks of units (pitch against wavelength, "
                        "frequency in Hz, all-zero data, ranges and ground against the array).")
+    @click.option("--frequency-file", type=click.Path(exists=True, dir_okay=False),
+                  default=None,
+                  help="A text file of the data's frequencies (one per line, Hz, or GHz "
+                       "where only GHz fits): the layout's frequency list.")
+    @click.option("--response", type=click.Path(exists=True, dir_okay=False), default=None,
+                  help="A CSV table of the device's response per frequency (frequency, "
+                       "re, im or amplitude, phase): each frequency divided by it.")
     @functools.wraps(fn)
-    def wrapper(*args: Any, layout: str | None, no_check: bool, **kwargs: Any) -> Any:
+    def wrapper(*args: Any, layout: str | None, no_check: bool, frequency_file: str | None,
+                response: str | None, **kwargs: Any) -> Any:
+        extra = []
+        if frequency_file is not None:
+            from ...io.response import read_frequencies
+
+            try:
+                f = read_frequencies(frequency_file)
+            except ValueError as exc:
+                raise click.BadParameter(str(exc), param_hint="--frequency-file") from None
+            extra.append("frequency=[" + " ".join(repr(float(v)) for v in f) + "]")
+            extra.append("frequency_unit=Hz")
+        if response is not None:
+            extra.append(f"response={response}")
+        if extra:
+            layout = ",".join([layout, *extra] if layout else extra)
         return fn(*args, layout=layout, check=not no_check, **kwargs)
 
     return wrapper
