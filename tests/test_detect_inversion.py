@@ -92,6 +92,7 @@ def test_gprmax_rod_with_its_dipole_is_one_line():
     assert abs(row.depth - 0.10) < 0.01
 
 
+@pytest.mark.slow   # the fast suite's mat is the 3 x 3 one without its noise, below
 def test_two_layer_mat_under_the_papers_array_with_its_noise_is_four_bars():
     # The paper's 16 x 16 array (2.5 cm: no evanescent band to estimate the noise from,
     # so it is given), 8-12 GHz, 11 frequencies, 30 dB: two bars along x under 4 cm of
