@@ -109,3 +109,24 @@ def test_progress_bars_only_on_a_terminal(monkeypatch):
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
     assert Reporter(False, False).progress is True
     assert Reporter(False, True).progress is False
+
+
+def test_a_survey_store_opens_in_xarray_without_a_warning(tmp_path):
+    # Consolidated metadata written at the end of each run: xarray.open_zarr finds every
+    # array in one document and says nothing; a second run that adds frames writes it
+    # again (xarray sees them).
+    import xarray as xr
+
+    x = (np.arange(8) - 3.5) * 0.01
+    paths = [hr.save(hr.Hologram(np.ones((8, 8)), x, x, 9.9e9, pose=hr.Pose((0.05 * i, 0, 0))),
+                     tmp_path / f"f{i}.nc") for i in range(3)]
+    store = tmp_path / "s.zarr"
+    hr.survey.run_batch(paths[:2], store, z=[0.2], scheduler="synchronous")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        n2 = xr.open_zarr(store)["frame_path"].size
+    hr.survey.run_batch(paths, store, z=[0.2], scheduler="synchronous")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        n3 = xr.open_zarr(store)["frame_path"].size
+    assert n3 > n2 or n3 >= 3

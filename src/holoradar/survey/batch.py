@@ -251,6 +251,9 @@ def run_batch(frames: Sequence[str | os.PathLike[str]], store: str | os.PathLike
         from .store import set_crs
 
         set_crs(target, crs)
+    from .store import consolidate
+
+    consolidate(target)
     summary["seconds"] = time.perf_counter() - t0
     return summary
 

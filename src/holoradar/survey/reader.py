@@ -73,7 +73,7 @@ def open_survey(store: str | os.PathLike[str]) -> Any:
                      "done": ("frame", idx["done"])}, coords=coords, attrs=idx["attrs"])
     for k in ("frame_x", "frame_y", "frame_z"):
         ds[k].attrs["units"] = "m"
-    ds["finished"].attrs["units"] = "s since 1970-01-01 UTC"
+    ds["finished"].attrs["units"] = "seconds since 1970-01-01 00:00:00"
     return ds
 
 

@@ -119,8 +119,8 @@ def is_survey(path: Path) -> bool:
     if not path.is_dir():
         return False
     try:
-        return str(zarr.open_group(str(path), mode="r").attrs.get("holoradar_survey", "")) \
-            == LAYOUT
+        g = zarr.open_group(str(path), mode="r", use_consolidated=False)
+        return str(g.attrs.get("holoradar_survey", "")) == LAYOUT
     except Exception:  # not a Zarr group at all
         return False
 
@@ -188,7 +188,8 @@ def create_store(target: Path, settings: Settings, geometry: FrameGeometry, *,
         arr("position", (0, 3), (k, 3), np.float64, ("frame", "xyz"), np.nan,
             long_name="world position (x, y, z) of the frame's centre", units="m")
         arr("finished", (0,), (k,), np.float64, ("frame",), np.nan,
-            long_name="when the frame was written (UTC)", units="s since 1970-01-01")
+            long_name="when the frame was written (UTC)",
+            units="seconds since 1970-01-01 00:00:00", calendar="standard")
         arr("done", (0,), (k,), bool, ("frame",), False,
             long_name="the frame's image and position are complete")
         arr("frame_name", (0,), (_NAME_CHUNK,), str, ("frame",), "",
@@ -259,7 +260,7 @@ def stored_settings(target: Path) -> tuple[Settings, FrameGeometry]:
     """The settings and geometry a store was made with."""
     import zarr
 
-    attrs = zarr.open_group(str(target), mode="r").attrs
+    attrs = zarr.open_group(str(target), mode="r", use_consolidated=False).attrs
     return Settings.from_dict(dict(attrs["settings"])), \
         FrameGeometry.from_dict(dict(attrs["geometry"]))
 
@@ -274,7 +275,7 @@ def register_frames(target: Path, paths: Sequence[Path]) -> list[int]:
     """
     import zarr
 
-    g = zarr.open_group(str(target), mode="r+")
+    g = zarr.open_group(str(target), mode="r+", use_consolidated=False)
     known_list = [str(p) for p in g["frame_path"][:]]
     length = max(g[a].shape[0] for a in FRAME_ARRAYS)
     known = {p: i for i, p in enumerate(known_list) if p}
@@ -318,7 +319,7 @@ def _handles(store: str, token: str) -> dict[str, Any]:
     key = (store, token)
     h = _HANDLES.get(key)
     if h is None:
-        g = zarr.open_group(store, mode="r+")
+        g = zarr.open_group(store, mode="r+", use_consolidated=False)
         # A frame's image is never all NaN (the fill value): written without Zarr's scan
         # for empty chunks (a millisecond or more for a chunk of a few MB).
         h = {name: _always_write(g[name]) for name in ("image", *_PER_FRAME)}
@@ -398,7 +399,7 @@ def read_index(target: Path) -> dict[str, Any]:
     if not is_survey(target):
         raise ValueError(f"store {str(target)!r} is not a holoradar survey store (no "
                          f"'holoradar_survey' = {LAYOUT!r} attribute in a Zarr group)")
-    g = zarr.open_group(str(target), mode="r")
+    g = zarr.open_group(str(target), mode="r", use_consolidated=False)
     n = min(g[a].shape[0] for a in FRAME_ARRAYS)
     out: dict[str, Any] = {"n": n, "group": g, "attrs": dict(g.attrs), "path": str(target)}
     for a in (*_PER_FRAME, *_NAMES):
@@ -437,7 +438,7 @@ def note_skipped(target: Path, skipped: dict[str, str], tried: Sequence[str],
     """
     import zarr
 
-    g = zarr.open_group(str(target), mode="r+")
+    g = zarr.open_group(str(target), mode="r+", use_consolidated=False)
     gone = set(tried)
     old = {str(k): str(v) for k, v in dict(g.attrs.get("skipped", {}) or {}).items()}
     old_st = {str(k): [int(u) for u in v]
@@ -461,7 +462,7 @@ def remembered_bad(target: Path) -> dict[str, str]:
     not changed since (same size and modification time): absolute path -> reason."""
     import zarr
 
-    attrs = zarr.open_group(str(target), mode="r").attrs
+    attrs = zarr.open_group(str(target), mode="r", use_consolidated=False).attrs
     reasons = {str(k): str(v) for k, v in dict(attrs.get("skipped", {}) or {}).items()}
     stamps = dict(attrs.get("skipped_stamp", {}) or {})
     return {p: reasons[p] for p, st in stamps.items()
@@ -578,7 +579,7 @@ def stored_crs(target: Path) -> Any:
     or None where the survey was made without one."""
     import zarr
 
-    text = zarr.open_group(str(target), mode="r").attrs.get("crs")
+    text = zarr.open_group(str(target), mode="r", use_consolidated=False).attrs.get("crs")
     if not text:
         return None
     from ..io.crs import as_crs
@@ -608,5 +609,16 @@ def set_crs(target: Path, crs: Any) -> None:
     import zarr
 
     auth = crs.to_authority()
-    g = zarr.open_group(str(target), mode="r+")
+    g = zarr.open_group(str(target), mode="r+", use_consolidated=False)
     g.attrs["crs"] = f"{auth[0]}:{auth[1]}" if auth else crs.to_wkt()
+
+
+def consolidate(target: Path) -> None:
+    """Write the store's consolidated metadata (one document of every array's metadata),
+    which ``xarray.open_zarr`` and other readers look for first (without it xarray warns
+    on every open). holoradar's own reads do not use it: a run cut short leaves it as
+    of the run before, and the arrays themselves are the truth; each finished run
+    writes it again."""
+    import zarr
+
+    zarr.consolidate_metadata(str(target))
