@@ -116,3 +116,20 @@ def test_a_frequency_list_in_the_layout_text():
         == (8.2, 9.1, 10.0)
     with pytest.raises(ValueError, match=r"a list of numbers such as \[8\.2"):
         Layout.parse("frequency=[8.2, x]")
+
+
+def test_an_image_with_nan_samples_is_said_on_reading(tmp_path):
+    # An image whose bytes were overwritten with NaN: info and plot (and every reader)
+    # say how many samples are not numbers.
+    from holoradar.io import NonFiniteWarning
+
+    x = (np.arange(8) - 3.5) * 0.01
+    img = hr.migrate(hr.Hologram(np.ones((8, 8)), x, x, 9.9e9), 0.2)
+    data = np.array(img.data)
+    data[2:4] = np.nan
+    p = hr.save(hr.Image(data, img.x, img.y, img.z, img.frequency, img.method,
+                         has_z_axis=img.has_z_axis), tmp_path / "i.nc")
+    with pytest.warns(NonFiniteWarning, match=f"{2 * img.x.size} of {data.size} samples"):
+        hr.load(p)
+    res = run("info", p)
+    assert "NaN or infinite" in res.output

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -26,7 +27,8 @@ from .netcdf import from_dataset, read_direct, read_history, to_dataset
 from .output import check_output, write_via_temp
 from .readers import read_variables
 
-__all__ = ["Layout", "load", "read_history", "read_sidecar", "read_variables", "save"]
+__all__ = ["Layout", "NonFiniteWarning", "load", "read_history", "read_sidecar", "read_variables",
+           "save"]
 
 NETCDF_SUFFIXES = (".nc", ".nc4")
 
@@ -166,6 +168,8 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             full = (side_layout or Layout()).merged(lay)
             obj = assemble(variables, full, what=src.name)
             device = "iq_sign" not in full.given
+    if isinstance(obj, Image):
+        _warn_non_finite(obj, src.name)
     response = _response(lay, src)
     if response is not None and isinstance(obj, Hologram):
         from .response import apply_response
@@ -184,6 +188,21 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
 
 _IQ_FIX = ("declare it in the layout, iq_sign=I-iQ (holoradar --layout '...,iq_sign=I-iQ', "
            "hr.load(path, layout='...,iq_sign=I-iQ')), or image hr.conjugate(hologram)")
+
+
+class NonFiniteWarning(UserWarning):
+    """A file's image holds NaN or infinite samples (a damaged file, or one written so)."""
+
+
+def _warn_non_finite(img: Image, what: str) -> None:
+    """Say so where an image holds NaN or infinite samples (a hologram with them is
+    refused: it cannot be imaged; an image is still shown, its gaps blank)."""
+    data = np.asarray(img.data)
+    bad = data.size - int(np.count_nonzero(np.isfinite(data)))
+    if bad:
+        warnings.warn(f"{what}: {bad} of {data.size} samples are NaN or infinite (a damaged "
+                      "file?): they show blank and are left out of peaks and levels",
+                      NonFiniteWarning, stacklevel=3)
 
 
 def _response(lay: Layout | None, src: Path) -> Path | None:
