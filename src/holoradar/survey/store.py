@@ -5,11 +5,13 @@ Layout (``survey.zarr``; dimensions named, so ``xarray.open_zarr`` reads it)::
     image       (frame, z, y, x, iq)  float64 (float32 for complex64 frames); I = iq 0,
                                       Q = iq 1; chunks of several frames (up to
                                       16 MiB, :func:`frames_per_chunk`), compressed
-                                      (Blosc LZ4, bit shuffle); NaN until written
+                                      (Blosc LZ4, bit shuffle), each chunk's
+                                      CRC-32C checked before it is decompressed;
+                                      NaN until written
     z           (z,)     ranges of the planes from the aperture, m
     y, x        (y,) (x,)  pixel offsets from the frame's centre, m (the same for all)
     position    (frame, xyz)  world position (x, y, z) of the frame's centre, m
-    finished    (frame,) when the frame was written, s since 1970-01-01 UTC
+    finished    (frame,) when the frame was written, seconds since 1970-01-01 UTC
     done        (frame,) True once the frame's image and position are complete
     frame_name  (frame,) the file's name; frame_path: its absolute path (the key)
     attributes  holoradar_survey (layout version), settings, geometry (JSON), created;
