@@ -154,3 +154,12 @@ def test_a_damaged_chunk_is_named_by_its_frames_not_a_crash(tmp_path):
     one_line_error(res, "damaged", "f0.nc")
     assert not (tmp_path / "m.nc").exists()
     one_line_error(run("detect", store, "--z", "0.2", ok=False), "damaged", "f0.nc")
+    # info names it among the damaged frames, by its checksum
+    info = hr.survey.describe_store(store)
+    assert [d["name"] for d in info["damaged"]] == ["f0.nc"] and \
+        "CRC-32C" in info["damaged"][0]["reason"]
+    assert "f0.nc" in run("info", store).output
+    # a rerun images the damaged frame again: the store is whole
+    s = hr.survey.run_batch(paths, store, z=[0.2], scheduler="synchronous")
+    assert s["done"] >= 1 and hr.survey.describe_store(store)["damaged"] == []
+    run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m.nc")

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..physics.medium import Medium
 from . import schedule
 from .checks import check_store, frame_paths, layout_text, where_asked
@@ -30,6 +32,7 @@ from .space import bytes_text as bytes_text  # re-exported: the command line's s
 from .space import folder_bytes, plan_space
 from .store import (
     create_store,
+    describe_store,
     frame_bytes,
     frames_per_chunk,
     is_survey,
@@ -347,7 +350,13 @@ def _todo(target: Path, intake: Intake) -> tuple[Todo, int]:
     path, name)``; and the frames per chunk of the store."""
     slots = register_frames(target, [p for p, _ in intake.frames])
     index = read_index(target)
-    done, chunk = index["done"], int(index["group"]["image"].chunks[0])
+    done, chunk = np.array(index["done"]), int(index["group"]["image"].chunks[0])
+    # A frame marked done whose chunk is damaged (missing, short, failing its checksum)
+    # is imaged again: the rerun repairs the store.
+    damaged = {d["path"] for d in describe_store(target)["damaged"]}
+    for i, p in enumerate(index["frame_path"]):
+        if str(p) in damaged:
+            done[i] = False
     todo = [(slot, str(p), name) for slot, (p, name) in zip(slots, intake.frames, strict=True)
             if not done[slot]]
     return todo, chunk
