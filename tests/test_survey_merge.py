@@ -163,3 +163,9 @@ def test_a_damaged_chunk_is_named_by_its_frames_not_a_crash(tmp_path):
     s = hr.survey.run_batch(paths, store, z=[0.2], scheduler="synchronous")
     assert s["done"] >= 1 and hr.survey.describe_store(store)["damaged"] == []
     run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m.nc")
+    # a missing chunk: named by mosaic, not drawn as a blank hole
+    import os
+
+    os.remove(chunks[-1])
+    one_line_error(run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m2.nc",
+                       ok=False), "damaged", "f3.nc", "missing")

@@ -86,7 +86,8 @@ def mosaic(store: str | os.PathLike[str], depth: float, *, pitch: float | None =
     Raises
     ------
     ValueError
-        Not a survey store, no frame done, bad depth or pitch.
+        Not a survey store, no frame done, bad depth or pitch, a frame whose image
+        chunk is missing or damaged (named).
 
     Examples
     --------
@@ -112,6 +113,16 @@ def mosaic(store: str | os.PathLike[str], depth: float, *, pitch: float | None =
     frames = np.nonzero(idx["done"])[0]
     if frames.size == 0:
         raise ValueError(f"store {str(store)!r} holds no finished frame to map")
+    # A frame marked done whose chunk is missing would read as blank (its fill value):
+    # a hole in the map and a wrong brightest point without a word. (A chunk damaged
+    # in place fails its checksum when read.)
+    from .store import describe_store
+
+    lost = describe_store(Path(store), checksums=False)["damaged"]
+    if lost:
+        raise ValueError(f"store {str(store)!r}: frame(s) "
+                         f"{', '.join(d['name'] for d in lost)} damaged ({lost[0]['reason']}): "
+                         "image them again with holoradar batch (a rerun repairs them)")
     zs, xo, yo = idx["z"], idx["x"], idx["y"]
     iz = int(np.argmin(np.abs(zs - dz)))
     sx = float(xo[1] - xo[0]) if xo.size > 1 else 1.0
