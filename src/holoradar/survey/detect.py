@@ -12,6 +12,7 @@ survey sections are this.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -84,8 +85,6 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
     args = dict(args)
     shown = args.pop("progress", None)
     args["progress"] = False
-    import sys
-
     # None: after a second of work, on a terminal only (a bar in a log is noise).
     with tqdm(total=len(frames), desc="detect (frames)", unit="frame", delay=1.0,
               disable=shown is False or (shown is None and not sys.stderr.isatty())) as bar:
