@@ -490,7 +490,8 @@ def test_damaged_stores_give_a_clear_error(survey_frames, tmp_path: Path, data) 
         victim.write_bytes(bytes(blob))
     for read in (lambda: hr.survey.open_survey(store).load(),
                  lambda: hr.survey.mosaic(store, 0.3),
-                 lambda: hr.survey.frame_image(store, 0)):
+                 lambda: hr.survey.frame_image(store, 0),
+                 lambda: hr.survey.describe_store(store)):
         try:
             read()
         except ValueError as exc:
