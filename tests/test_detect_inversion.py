@@ -202,3 +202,23 @@ def test_the_floor_is_the_model_error_of_what_was_found_at_most():
         pytest.approx(MODEL_ERROR**2)
     # never below the noise's threshold squared
     assert _floor(0.5, residual=0.1, noise_norm=0.1, found=1.0) == pytest.approx(0.25)
+
+
+def test_fragments_join_a_bar_near_its_own_voxels_not_through_each_other():
+    # A bar along x and a chain of weak pieces leaving it along y, each within a cell of
+    # the one before: only the piece by the bar's own voxels is its fragment (a chain
+    # would widen the bar along every bar that crosses it).
+    from holoradar.analysis.detect.reflectivity import _merge_fragments
+
+    cell, rc = 0.02, 0.015
+
+    def ob(xs, ys, w):
+        xs, ys = np.atleast_1d(xs).astype(float), np.atleast_1d(ys).astype(float)
+        n = xs.size
+        return {"w": np.full(n, w), "vals": np.full(n, np.sqrt(w) + 0j), "x": xs, "y": ys,
+                "z": np.full(n, 0.25), "c": np.ones(n), "dx": 0.005, "dz": 0.005}
+
+    bar = ob(np.arange(-0.15, 0.151, 0.005), np.zeros(61), 1.0)
+    chain = [ob(0.0, 0.015 * (k + 1), 1e-3) for k in range(4)]   # 1.5 cm steps in y
+    kept = _merge_fragments([bar, *chain], cell, rc)
+    assert len(kept) == 4 and kept[0]["x"].size == 62     # the first piece only

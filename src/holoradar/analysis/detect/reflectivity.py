@@ -328,18 +328,21 @@ def _merge_fragments(objects: list[dict[str, Any]], cell: float, range_cell: flo
     misses of a full-wave object (5-15 % in amplitude) lands there too; neither is
     another object."""
     kept: list[dict[str, Any]] = []
+    cores: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     ratio = 10 ** (FRAGMENT_DB / 10)
     for ob in objects:
         cx, cy, cz = (float(np.average(ob[k], weights=ob["w"])) for k in ("x", "y", "z"))
         host = None
-        for big in kept:
-            near = (np.hypot(big["x"] - cx, big["y"] - cy) <= cell) & \
-                (np.abs(big["z"] - cz) <= range_cell)
+        # Near an object's own voxels, not those of the fragments it took: else a bar
+        # grows fragment by fragment along the bars that cross it.
+        for big, (bx, by, bz) in zip(kept, cores, strict=True):
+            near = (np.hypot(bx - cx, by - cy) <= cell) & (np.abs(bz - cz) <= range_cell)
             if near.any() and _energy(ob) < ratio * _energy(big):
                 host = big
                 break
         if host is None:
             kept.append(dict(ob))
+            cores.append((ob["x"], ob["y"], ob["z"]))
         else:
             for k in ("w", "vals", "x", "y", "z", "c"):
                 host[k] = np.concatenate([host[k], ob[k]])
