@@ -74,3 +74,16 @@ def test_bad_tables_are_refused_by_name(tmp_path):
     one_line_error(run("image", tmp_path / "scan.npz", "--z", "0.17", "--frequency-file",
                        words, "-o", tmp_path / "o.nc", ok=False), "--frequency-file")
     assert not (tmp_path / "o.nc").exists()
+
+
+def test_a_sidecars_layout_may_name_the_response(tmp_path):
+    # scan.npz + scan.json holding {"layout": {..., "response": "response.csv"}}: the
+    # device's own description, applied as if given.
+    import json
+
+    h, table, _ = _device(tmp_path)
+    (tmp_path / "scan.json").write_text(json.dumps({"layout": {
+        "axes": "fyx", "frequency": [5.7, 6.95, 8.2], "frequency_unit": "GHz",
+        "monostatic": True, "response": table.name, "iq_sign": "I+iQ"}}))
+    got = hr.load(tmp_path / "scan.npz")
+    assert np.max(np.abs(got.data - h.data)) / np.max(np.abs(h.data)) < 1e-12

@@ -143,6 +143,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     lay = _as_layout(layout)
     obj = None
     device = False
+    used = lay          # the layout the file was read with (a sidecar's merged in)
     # holoradar's own file: its layout is its own (a response table still applies)
     if src.suffix.lower() in NETCDF_SUFFIXES and (lay is None or lay.given <= {"response"}):
         try:  # holoradar's own file, read in one pass (a survey reads thousands)
@@ -166,11 +167,12 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             obj = _npz_image(variables, src.name)
         else:
             full = (side_layout or Layout()).merged(lay)
+            used = full
             obj = assemble(variables, full, what=src.name)
             device = "iq_sign" not in full.given
     if isinstance(obj, Image):
         _warn_non_finite(obj, src.name)
-    response = _response(lay, src)
+    response = _response(used, src)
     if response is not None and isinstance(obj, Hologram):
         from .response import apply_response
 
