@@ -87,3 +87,15 @@ def test_a_sidecars_layout_may_name_the_response(tmp_path):
         "monostatic": True, "response": table.name, "iq_sign": "I+iQ"}}))
     got = hr.load(tmp_path / "scan.npz")
     assert np.max(np.abs(got.data - h.data)) / np.max(np.abs(h.data)) < 1e-12
+
+
+def test_frequencies_written_in_hz_are_taken_in_hz():
+    # 0.2-0.9 GHz written in Hz fit Hz (and, as numbers, kHz): taken as written.
+    import tempfile
+    from pathlib import Path
+
+    from holoradar.io.response import read_frequencies
+
+    p = Path(tempfile.mkdtemp()) / "f.txt"
+    p.write_text("2e8\n5e8\n9e8\n")
+    assert read_frequencies(p).tolist() == [2e8, 5e8, 9e8]

@@ -169,3 +169,26 @@ def test_a_damaged_chunk_is_named_by_its_frames_not_a_crash(tmp_path):
     os.remove(chunks[-1])
     one_line_error(run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m2.nc",
                        ok=False), "damaged", "f3.nc", "missing")
+
+
+def test_bars_stacked_in_depth_and_objects_one_frame_told_apart_stay_apart():
+    # A bar over another (4 and 20 cm deep, depth intervals apart), both seen by two
+    # frames: two bars. Two points one frame tells apart, a point of another frame
+    # between them: still two objects.
+    def deep(row, depth):
+        return {**row, "depth": depth, "depth_low": depth - 0.005, "depth_high": depth + 0.005}
+
+    rows = [deep(_line("a", -0.3, 0.0), 0.04), deep(_line("b", -0.05, 0.3), 0.04),
+            deep(_line("a", -0.3, 0.0, y=0.005), 0.20),
+            deep(_line("b", -0.05, 0.3, y=0.005), 0.20)]
+    t = merge(pd.DataFrame(rows))
+    assert sorted(t.depth) == [0.04, 0.20] and list(t.frames) == ["a;b", "a;b"]
+    pts = [_point("a", 0.0, 0.0), _point("a", 0.035, 0.0), _point("b", 0.018, 0.0)]
+    assert len(merge(pd.DataFrame(pts))) == 2
+
+
+def test_spacing_is_between_bars_side_by_side_not_end_to_end():
+    rows = [_line("a", -0.3, -0.1), _line("a", -0.3, -0.1, y=0.15), _line("b", 0.1, 0.3)]
+    t = merge(pd.DataFrame(rows)).sort_values(["x", "y"])
+    assert t.spacing.tolist()[:2] == pytest.approx([0.15, 0.15])
+    assert np.isnan(t.spacing.tolist()[2])

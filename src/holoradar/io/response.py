@@ -29,6 +29,8 @@ _UNITS = {"Hz": 1.0, "kHz": 1e3, "MHz": 1e6, "GHz": 1e9}
 def _hz(values: np.ndarray, what: str) -> np.ndarray:
     fits = [u for u, s in _UNITS.items() if np.all(values * s >= 1e8)
             and np.all(values * s <= 1e12)]
+    if "Hz" in fits:        # in Hz where they fit: written as they are
+        fits = ["Hz"]
     if len(fits) != 1:
         raise ValueError(f"{what}: frequencies {values.min():g} to {values.max():g} could be "
                          f"in {', '.join(fits) or 'no unit between 0.1 GHz and 1 THz'}: write "

@@ -155,6 +155,8 @@ def _unit(f: np.ndarray, name: str) -> str:
     """The unit that puts every frequency in 0.1 GHz to 1 THz; refused where not one."""
     fits = [u for u, s in _UNITS.items()
             if np.all(f * s >= _BAND[0]) and np.all(f * s <= _BAND[1])]
+    if "Hz" in fits:        # in Hz where they fit: written as they are
+        fits = ["Hz"]
     if len(fits) != 1:
         raise ValueError(f"{name}: the header's frequencies ({f.min():g} to {f.max():g}) could "
                          f"be in {', '.join(fits) or 'no unit between 0.1 GHz and 1 THz'}: "

@@ -93,11 +93,10 @@ def from_store(path: Path, plane: float | None, args: Mapping[str, Any], *,
             tables.append(df)
             bar.update(1)
             if log is not None:
-                text = f"frame {idx['frame_name'][i]}: {len(df)} object(s)"
-                if bar.disable:
-                    log(text)
-                else:           # above the bar, which stays at the bottom
-                    bar.write(text)
+                # the caller's own line (it knows --json and -q), the bar cleared
+                # for it and drawn again below
+                with bar.external_write_mode():
+                    log(f"frame {idx['frame_name'][i]}: {len(df)} object(s)")
     merged = _gathered(tables)
     merged.attrs["eps_interval"] = None if args.get("eps_interval") is None else \
         list(args["eps_interval"])

@@ -13,8 +13,12 @@ kind from different frames are one object when
   within two cells beyond its ends (a frame that holds only a few cells of a bar,
   or its end, sees it as points).
 
-The groups are closed under that relation (a pipe crossing seven frames is one
-chain). A group is kept as the row of the frame it lies nearest the centre of (its
+Rows whose depths cannot be one object (95 % intervals apart, or ranges more than
+a cell apart without intervals) are never joined: a bar over another is two. The
+groups are closed under that relation (a pipe crossing seven frames is one chain),
+but two rows one frame told apart are never put in one group (only a point on a
+line may join a group its frame is in: a piece of that bar). A group is kept as the
+row of the frame it lies nearest the centre of (its
 fit there is the best: the whole aperture around it; a line's if the group has
 one), except that a line's extent becomes the group's: its ends are the extreme
 ends of all its rows projected on the axis of the longest line (a point counting
@@ -71,6 +75,8 @@ def merge(df: Any) -> Any:
 
     if df.empty:
         out = df.drop(columns=[c for c in _HELPERS if c in df])
+        if "spacing" not in out:
+            out["spacing"] = pd.Series(dtype=float)
         out["frames"] = pd.Series(dtype=object)
         return out
     rows = df.reset_index(drop=True)
@@ -107,10 +113,18 @@ def _groups(rows: Any) -> list[list[int]]:
         return i
 
     recs = rows.to_dict("records")
+    frames = [{r["frame"]} for r in recs]     # the frames in each root's group
     for i in range(len(recs)):
         for j in range(i + 1, len(recs)):
-            if recs[i]["frame"] != recs[j]["frame"] and _same(recs[i], recs[j]):
-                parent[find(i)] = find(j)
+            if recs[i]["frame"] == recs[j]["frame"] or not _same(recs[i], recs[j]):
+                continue
+            a, b = find(i), find(j)
+            # Two objects one frame told apart stay apart, whatever joins them: only a
+            # point on a line may join a group its frame is in (a piece of that bar).
+            piece = {recs[i]["kind"], recs[j]["kind"]} == {"point", "line"}
+            if a != b and (piece or not frames[a] & frames[b]):
+                parent[a] = b
+                frames[b] |= frames[a]
     out: dict[int, list[int]] = {}
     for i in range(len(recs)):
         out.setdefault(find(i), []).append(i)
@@ -118,6 +132,8 @@ def _groups(rows: Any) -> list[list[int]]:
 
 
 def _same(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    if not _same_depth(a, b):
+        return False
     cell = max(float(a["_cell"]), float(b["_cell"]))
     if {a["kind"], b["kind"]} == {"point", "line"}:
         p, ln = (a, b) if a["kind"] == "point" else (b, a)
@@ -140,12 +156,26 @@ def _same(a: dict[str, Any], b: dict[str, Any]) -> bool:
     return across < cell and along - 0.5 * (a["length"] + b["length"]) < 2 * cell
 
 
-def _num(v: Any) -> float:
+def _same_depth(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two rows can be one object in depth: their 95 % depth intervals overlap
+    where both have one; else their ranges lie within a lateral cell (a plane's rows,
+    a one-frequency fit)."""
+    lo = (_num(a.get("depth_low"), math.nan), _num(b.get("depth_low"), math.nan))
+    hi = (_num(a.get("depth_high"), math.nan), _num(b.get("depth_high"), math.nan))
+    if all(math.isfinite(v) for v in (*lo, *hi)):
+        return lo[0] <= hi[1] and lo[1] <= hi[0]
+    ra, rb = _num(a.get("range"), math.nan), _num(b.get("range"), math.nan)
+    if math.isfinite(ra) and math.isfinite(rb):
+        return abs(ra - rb) <= max(float(a["_cell"]), float(b["_cell"]))
+    return True
+
+
+def _num(v: Any, default: float = 0.0) -> float:
     try:
         f = float(v)
     except (TypeError, ValueError):
-        return 0.0
-    return f if math.isfinite(f) else 0.0
+        return default
+    return f if math.isfinite(f) else default
 
 
 def _joined_line(sub: Any, points: Any) -> dict[str, float]:
@@ -177,7 +207,8 @@ def _without_pieces(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     lines = [r for r in rows if r["kind"] == "line" and ";" in r["frames"]]
     out = []
     for r in rows:
-        if r["kind"] == "point" and any(_on_line(r, ln) for ln in lines):
+        if r["kind"] == "point" and any(_on_line(r, ln) and _same_depth(r, ln)
+                                        for ln in lines):
             continue
         out.append(r)
     return out
@@ -195,11 +226,18 @@ def _on_line(p: dict[str, Any], line: dict[str, Any], reach: float | None = None
 
 
 def _spacing(rows: list[dict[str, Any]]) -> None:
-    """Each line's distance across it to the nearest parallel line (within 15 degrees)."""
+    """Each line's distance across it to the nearest parallel line (within 15 degrees)
+    beside it (their extents overlapping along the axis: bars end to end have none)."""
     lines = [r for r in rows if r["kind"] == "line"]
     for a in lines:
         t = math.radians(a["azimuth_deg"])
-        gaps = [abs(-(b["x"] - a["x"]) * math.sin(t) + (b["y"] - a["y"]) * math.cos(t))
-                for b in lines if b is not a
-                and abs((a["azimuth_deg"] - b["azimuth_deg"] + 90.0) % 180.0 - 90.0) <= 15.0]
+        gaps = []
+        for b in lines:
+            if b is a or abs((a["azimuth_deg"] - b["azimuth_deg"] + 90.0) % 180.0
+                             - 90.0) > 15.0:
+                continue
+            dx, dy = b["x"] - a["x"], b["y"] - a["y"]
+            if abs(dx * math.cos(t) + dy * math.sin(t)) > 0.5 * (a["length"] + b["length"]):
+                continue
+            gaps.append(abs(-dx * math.sin(t) + dy * math.cos(t)))
         a["spacing"] = min(gaps) if gaps else np.nan
