@@ -75,6 +75,7 @@ def test_a_points_reflectivity_has_no_sidelobes(two_points):
         assert (level > bound) if how == "adjoint" else (level < bound), (how, level)
 
 
+@pytest.mark.slow   # test_detect_inversion's three bars beside a dipole cover it quickly
 def test_equal_bars_under_a_dipole_beside_the_array_are_equal():
     # Three equal bars 6 cm under a concrete surface, along the dipole that lights
     # them from 25 cm beside the array: the adjoint image falls by the illumination

@@ -75,12 +75,12 @@ def regular_axis(values: np.ndarray, data: np.ndarray, name: str, axis: int
         d = -d[::-1]
     if np.any(d <= 0) or v.size < 3:
         return v, data      # the caller's check says what is wrong
+    if np.max(np.abs(d - d.mean())) <= 1e-6 * abs(d.mean()):
+        return v, data      # uniform already (the FFT's own tolerance): the usual case
     k = np.arange(v.size, dtype=float)
     step, start = np.polyfit(k, v, 1)
     grid = start + step * k
     off = float(np.max(np.abs(v - grid)))
-    if off == 0.0 or np.max(np.abs(d - d.mean())) <= 1e-6 * abs(d.mean()):
-        return v, data      # uniform already (the FFT's own tolerance)
     if off <= SNAP_FRACTION * step:
         warnings.warn(f"{name}: the coordinates lie within {off:.2g} m of a uniform grid of "
                       f"pitch {step:.6g} m (their written precision): snapped to it",

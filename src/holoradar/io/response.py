@@ -21,21 +21,14 @@ from typing import Any
 
 import numpy as np
 
+from .band_unit import band_unit
+from .layout import FREQUENCY_UNITS
+
 __all__ = ["apply_response", "read_frequencies", "read_response"]
 
-_UNITS = {"Hz": 1.0, "kHz": 1e3, "MHz": 1e6, "GHz": 1e9}
-
-
 def _hz(values: np.ndarray, what: str) -> np.ndarray:
-    fits = [u for u, s in _UNITS.items() if np.all(values * s >= 1e8)
-            and np.all(values * s <= 1e12)]
-    if "Hz" in fits:        # in Hz where they fit: written as they are
-        fits = ["Hz"]
-    if len(fits) != 1:
-        raise ValueError(f"{what}: frequencies {values.min():g} to {values.max():g} could be "
-                         f"in {', '.join(fits) or 'no unit between 0.1 GHz and 1 THz'}: write "
-                         "them in Hz")
-    return np.round(values * _UNITS[fits[0]], 3)
+    unit = band_unit(values, what, "write them in Hz")
+    return np.round(values * FREQUENCY_UNITS[unit], 3)
 
 
 def read_frequencies(path: str | Path) -> np.ndarray:

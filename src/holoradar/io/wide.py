@@ -29,10 +29,11 @@ from typing import Any
 
 import numpy as np
 
+from .band_unit import band_unit
+from .layout import FREQUENCY_UNITS
+
 __all__ = ["read_wide"]
 
-_UNITS = {"Hz": 1.0, "kHz": 1e3, "MHz": 1e6, "GHz": 1e9}
-_BAND = (1e8, 1e12)
 _SPLIT = re.compile(r"\s*[,;\t]\s*|\s+")
 
 
@@ -107,8 +108,10 @@ def read_wide(path: Path, frequency_unit: str | None, values: str = "reim"
                          f"frequency twice ({'Re, Im' if values == 'reim' else 'mag, phase'}), "
                          f"got {fcols[:8]}{' ...' if len(fcols) > 8 else ''}")
     f = np.array(freq[::2], dtype=float)
-    unit = frequency_unit or _unit(f, path.name)
-    hz = np.round(f * _UNITS[unit], 3)     # 8.2 GHz is 8200000000 Hz, not ...999.999
+    unit = frequency_unit or band_unit(
+        f, f"{path.name} header", "say which in the layout, frequency_unit=GHz (or "
+        "Hz, kHz, MHz)")
+    hz = np.round(f * FREQUENCY_UNITS[unit], 3)     # 8.2 GHz is 8200000000 Hz, not ...999.999
     rows = []
     for n, line in enumerate(lines[head + 1:], start=head + 2):
         cells = _cells(line)
@@ -149,16 +152,3 @@ def _header(lines: list[str], name: str) -> int:
             return i
     raise ValueError(f"{name}: no header row (coordinate names X, Y, then the frequencies, "
                      "each twice) in a wide table")
-
-
-def _unit(f: np.ndarray, name: str) -> str:
-    """The unit that puts every frequency in 0.1 GHz to 1 THz; refused where not one."""
-    fits = [u for u, s in _UNITS.items()
-            if np.all(f * s >= _BAND[0]) and np.all(f * s <= _BAND[1])]
-    if "Hz" in fits:        # in Hz where they fit: written as they are
-        fits = ["Hz"]
-    if len(fits) != 1:
-        raise ValueError(f"{name}: the header's frequencies ({f.min():g} to {f.max():g}) could "
-                         f"be in {', '.join(fits) or 'no unit between 0.1 GHz and 1 THz'}: "
-                         "say which in the layout, frequency_unit=GHz (or Hz, kHz, MHz)")
-    return fits[0]

@@ -83,7 +83,9 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
         if is_ours:  # a damaged holoradar file: its error is the answer
             raise
         reason = str(exc)
-    wide = obj is not None and layout is not None and "wide" in layout
+    from ...io.layout import Layout
+
+    wide = obj is not None and layout is not None and Layout.parse(layout).wide is not None
     if (obj is None or not is_ours) and not wide:   # a wide table has no variables
         variables = read_variables(file)
         summary["variables"] = {k: {"shape": list(v.shape), "dtype": str(v.dtype)}
