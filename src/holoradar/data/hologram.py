@@ -22,6 +22,7 @@ from .._validate import (
     uniform_step,
 )
 from .pose import IDENTITY, Pose
+from .tx_offset import as_tx_offset
 
 __all__ = ["C0", "Hologram", "Image"]
 
@@ -68,6 +69,16 @@ class Hologram:
         the vector model (TE and TM waves, the dipole's near field). Default
         ``None``: the scalar model, in which the field is the tangential
         electric field of TE waves only.
+    tx_offset : (float, float, float), optional
+        A transmitter that moves with the receiver, metres: the sample at (x, y) is
+        the field received at (x, y) of a transmitter at ``(x + dx, y + dy, dz)``
+        (``dz`` towards the scene along the aperture's normal; two numbers: ``dz =
+        0``). The echo of a point at ``r`` is then ``g(r_rx, r) g(r_tx, r)`` instead
+        of a transceiver's ``g(r_rx, r)^2``; migration and the linear operator use it
+        exactly. The hologram is then a scanned pair (``monostatic`` is True, no
+        separate ``source``). ``None`` or ``(0, 0, 0)``: no offset (a transceiver
+        when ``monostatic=True``). Longer than the aperture's diagonal is refused (a
+        length in millimetres given as metres, most likely).
 
     Examples
     --------
@@ -89,10 +100,12 @@ class Hologram:
     monostatic: bool = False
     pose: Pose = IDENTITY
     polarization: np.ndarray | None = None
+    tx_offset: tuple[float, float, float] | None = None
 
     def __init__(self, data: Any, x: Any, y: Any, frequency: Any, *,
                  source: Any = None, monostatic: bool = False,
-                 pose: Pose | None = None, polarization: Any = None) -> None:
+                 pose: Pose | None = None, polarization: Any = None,
+                 tx_offset: Any = None) -> None:
         arr = as_finite_complex(data, "data", min_ndim=2)
         # A reversed axis, or one rounded to a text export's digits: made increasing
         # and uniform, said once (data/grid_axes.py).
@@ -106,6 +119,12 @@ class Hologram:
                              f"{type(source).__name__}")
         if not isinstance(monostatic, bool | np.bool_):
             raise ValueError(f"monostatic must be True or False, got {monostatic!r}")
+        offset = as_tx_offset(tx_offset, xa, ya)
+        if offset is not None and source is not None:
+            raise ValueError("a hologram with tx_offset has its transmitter beside each "
+                             "receiver (it moves with it): it has no separate source; pass "
+                             "source=None")
+        monostatic = bool(monostatic) or offset is not None
         if monostatic and source is not None:
             raise ValueError("a monostatic hologram (scanned transceiver) has no separate "
                              "source: the transceiver at each sample lights the scene itself; "
@@ -133,6 +152,7 @@ class Hologram:
         object.__setattr__(self, "monostatic", bool(monostatic))
         object.__setattr__(self, "pose", IDENTITY if pose is None else pose)
         object.__setattr__(self, "polarization", pol)
+        object.__setattr__(self, "tx_offset", offset)
 
     @property
     def is_vector(self) -> bool:
@@ -196,7 +216,7 @@ class Hologram:
             raise ValueError(f"index must be in [0, {self.nf}), got {index}")
         return Hologram(self.data[..., i, :, :], self.x, self.y, float(self.frequencies[i]),
                         source=self.source, monostatic=self.monostatic, pose=self.pose,
-                        polarization=self.polarization)
+                        polarization=self.polarization, tx_offset=self.tx_offset)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -234,17 +254,18 @@ class Hologram:
         """
         return Hologram(data, self.x, self.y, self.frequency, source=self.source,
                         monostatic=self.monostatic, pose=self.pose,
-                        polarization=self.polarization)
+                        polarization=self.polarization, tx_offset=self.tx_offset)
 
     def replace(self, **changes: Any) -> Hologram:
         """A copy with some fields replaced (``dataclasses.replace`` semantics)."""
         kw = {"data": self.data, "x": self.x, "y": self.y, "frequency": self.frequency,
               "source": self.source, "monostatic": self.monostatic, "pose": self.pose,
-              "polarization": self.polarization}
+              "polarization": self.polarization, "tx_offset": self.tx_offset}
         kw.update(changes)
         src, mono, pose = kw.pop("source"), kw.pop("monostatic"), kw.pop("pose")
-        pol = kw.pop("polarization")
-        return Hologram(**kw, source=src, monostatic=mono, pose=pose, polarization=pol)
+        pol, offset = kw.pop("polarization"), kw.pop("tx_offset")
+        return Hologram(**kw, source=src, monostatic=mono, pose=pose, polarization=pol,
+                        tx_offset=offset)
 
 
 def has_polarization(source: Any) -> bool:

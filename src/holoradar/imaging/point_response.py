@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from ..data.hologram import C0, Hologram
+from ..data.tx_offset import refuse_tx_offset
 from ..physics.dipole import Dipole
 from ..physics.dyadic import (
     buried_dipole_dyadic,
@@ -104,6 +105,7 @@ class PointResponse:
 
     def __init__(self, hologram: Hologram, make_medium: Callable[[float], Medium], *,
                  coherent: bool, phase_only: bool = False) -> None:
+        refuse_tx_offset(hologram, "the point response (autofocus, detection's model)")
         self.phase_only = bool(phase_only)
         self.h = hologram.data.reshape(hologram.nf, -1)
         self.energy = float(np.vdot(self.h, self.h).real)

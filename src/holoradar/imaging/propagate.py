@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from ..data.tx_offset import refuse_tx_offset
+
 __all__ = ["propagate"]
 
 
@@ -86,6 +88,8 @@ def propagate(hologram: Any, distance: float, *, medium: Any = None,
     if not isinstance(hologram, Hologram):
         raise ValueError(f"hologram must be a holoradar.Hologram, got "
                          f"{type(hologram).__name__}")
+    refuse_tx_offset(hologram, "propagate (a field of one transmitter, carried plane to "
+                     "plane)")
     if isinstance(distance, bool) or not isinstance(distance, int | float | np.floating) \
             or not math.isfinite(float(distance)):
         raise ValueError(f"distance must be a finite number of metres (> 0 away from the "

@@ -85,6 +85,10 @@ class Layout:
         ``"I-iQ"``: the device records the conjugate (conjugated on reading).
     monostatic : bool
         A scanned transceiver (see :class:`~holoradar.Hologram`).
+    tx_offset : list of float, optional
+        A transmitter beside the scanned receiver, ``[dx, dy]`` or ``[dx, dy, dz]``
+        in ``length_unit`` (``tx_offset=[120, 0, 0]`` with ``units=mm``): the
+        hologram's ``tx_offset`` (implies ``monostatic``).
     wide : {"reim", "magphase"}, optional
         A scanner's wide text table (any suffix): after metadata lines, a header
         row naming the coordinates (``X``, ``Y``) and each frequency twice, then one
@@ -117,6 +121,7 @@ class Layout:
     phase_unit: str = "rad"
     iq_sign: str = "I+iQ"
     monostatic: bool = False
+    tx_offset: tuple[float, ...] | None = None
     wide: str | None = None
     response: str | None = None
     given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
@@ -167,6 +172,12 @@ class Layout:
                                  f"number(s), got {f!r}")
         if not isinstance(self.monostatic, bool):
             raise ValueError(f"layout monostatic must be true or false, got {self.monostatic!r}")
+        d = self.tx_offset
+        if d is not None and (isinstance(d, str) or not _numeric(d)
+                              or np.shape(d) not in ((2,), (3,))
+                              or not np.all(np.isfinite(np.asarray(d, float)))):
+            raise ValueError("layout tx_offset must be [dx, dy] or [dx, dy, dz] in the "
+                             f"layout's length unit, got {d!r}")
         if self.response is not None and (not isinstance(self.response, str)
                                           or not self.response.strip()):
             raise ValueError(f"layout response must be a file's path, got {self.response!r}")
@@ -189,8 +200,9 @@ class Layout:
         if unknown:
             raise ValueError(f"{what}: unknown key(s) {unknown}; known: {sorted(known)} "
                              "(and units)")
-        if isinstance(m.get("frequency"), list):
-            m["frequency"] = tuple(m["frequency"])
+        for key in ("frequency", "tx_offset"):
+            if isinstance(m.get(key), list):
+                m[key] = tuple(m[key])
         if m.get("wide") is True or (isinstance(m.get("wide"), str)
                                      and m["wide"].lower() in ("true", "yes", "1")):
             m["wide"] = "reim"
@@ -224,13 +236,17 @@ class Layout:
             key, value = key.strip(), value.strip()
             if key in ("pitch", "frequency") and _is_number(value):
                 m[key] = float(value)
-            elif key == "frequency" and value.startswith("[") and value.endswith("]"):
+            elif key in ("frequency", "tx_offset") and value.startswith("[") \
+                    and value.endswith("]"):
                 # a list: frequency=[8.2, 9.1, 10.0] (commas or spaces between)
                 items = [v for v in re.split(r"[,\s]+", value[1:-1]) if v]
                 if not items or not all(_is_number(v) for v in items):
-                    raise ValueError("layout frequency must be a number, a list of numbers "
-                                     f"such as [8.2, 9.1, 10] or a variable name, got {value!r}")
+                    raise ValueError(f"layout {key} must be a list of numbers such as "
+                                     f"[8.2, 9.1, 10], got {value!r}")
                 m[key] = tuple(float(v) for v in items)
+            elif key == "tx_offset":
+                raise ValueError("layout tx_offset must be a list [dx, dy, dz] in the "
+                                 f"layout's length unit, got {value!r}")
             elif key == "monostatic":
                 if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
                     raise ValueError(f"layout monostatic must be true or false, got {value!r}")
@@ -249,6 +265,13 @@ class Layout:
                                and getattr(other, f.name) != getattr(default, f.name)}
         changes = {k: getattr(other, k) for k in keys}
         return replace(self, **changes, given=self.given | frozenset(keys))
+
+
+def layout_tx_offset(lay: Layout) -> tuple[float, ...] | None:
+    """The layout's ``tx_offset`` in metres (None: none given)."""
+    if lay.tx_offset is None:
+        return None
+    return tuple(float(v) * LENGTH_UNITS[lay.length_unit] for v in lay.tx_offset)
 
 
 def _numeric(v: Any) -> bool:
@@ -537,6 +560,7 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
 def _hologram(field: np.ndarray, x: np.ndarray, y: np.ndarray, f: Any, lay: Layout,
               what: str) -> Hologram:
     try:
-        return Hologram(field, x, y, f, monostatic=lay.monostatic)
+        return Hologram(field, x, y, f, monostatic=lay.monostatic,
+                        tx_offset=layout_tx_offset(lay))
     except ValueError as exc:
         raise ValueError(f"{what}: {exc}") from None

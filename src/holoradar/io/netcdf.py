@@ -189,6 +189,8 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
             attrs["source"] = src
         if obj.polarization is not None:
             attrs["polarization"] = np.asarray(obj.polarization, float)
+        if obj.tx_offset is not None:
+            attrs["tx_offset_m"] = np.asarray(obj.tx_offset, float)
         long_name = "received field at the elements"
     elif isinstance(obj, Image):
         kind, var = "Image", "image"
@@ -219,6 +221,16 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
         values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
                              {"long_name": long_name, "units": "1"})
     return xr.Dataset({var: values}, coords=coords, attrs=attrs)
+
+
+def _tx_offset(value: Any, what: str) -> tuple[float, ...] | None:
+    """The stored ``tx_offset_m`` attribute (3 numbers, metres), or None."""
+    if value is None:
+        return None
+    d = np.asarray(value, float).ravel()
+    if d.size != 3:
+        raise ValueError(f"{what}: tx_offset_m must hold 3 numbers (metres), got {d.size}")
+    return tuple(float(v) for v in d)
 
 
 def _polarization(value: Any, what: str) -> np.ndarray | None:
@@ -282,7 +294,8 @@ def from_dataset(ds: Any, what: str = "file") -> Hologram | Image:
         out = Hologram(data, x, y, freq,
                        source=None if src is None else source_from_json(str(src)),
                        monostatic=bool(int(ds.attrs.get("monostatic", 0))),
-                       pose=None if pose.is_identity else pose, polarization=pol)
+                       pose=None if pose.is_identity else pose, polarization=pol,
+                       tx_offset=_tx_offset(ds.attrs.get("tx_offset_m"), what))
         if pol is not None and np.allclose(pol, out.polarization, rtol=0, atol=1e-12):
             pol.setflags(write=False)  # the stored unit vector, bit for bit
             object.__setattr__(out, "polarization", pol)

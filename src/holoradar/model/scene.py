@@ -10,6 +10,7 @@ import numpy as np
 
 from .._validate import as_axis, as_polarization
 from ..data.pose import IDENTITY, Pose
+from ..data.tx_offset import as_tx_offset
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave
 from .targets import LineTarget, PlanarTarget, PointTarget
@@ -40,6 +41,11 @@ class Aperture:
         Unit vector (world axes) of the field component the elements record;
         with a polarised source, :func:`holoradar.simulate` uses the vector model
         and the hologram carries it. Default ``None``: the scalar model.
+    tx_offset : (float, float, float), optional
+        A transmitter beside each scan position, metres (``dx, dy`` in the
+        aperture's plane, ``dz`` towards the scene): the elements are the
+        positions of a scanned receiver whose transmitter moves with it (implies
+        ``monostatic``; the scalar model). See :class:`holoradar.Hologram`.
 
     Examples
     --------
@@ -55,10 +61,17 @@ class Aperture:
     monostatic: bool = False
     pose: Pose = IDENTITY
     polarization: np.ndarray | None = None
+    tx_offset: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         pol = as_polarization(self.polarization, "polarization")
         object.__setattr__(self, "polarization", pol)
+        object.__setattr__(self, "x", as_axis(self.x, "x"))
+        object.__setattr__(self, "y", as_axis(self.y, "y"))
+        offset = as_tx_offset(self.tx_offset, self.x, self.y)
+        object.__setattr__(self, "tx_offset", offset)
+        if offset is not None:
+            object.__setattr__(self, "monostatic", True)
         if self.pose is None:
             object.__setattr__(self, "pose", IDENTITY)
         if not isinstance(self.pose, Pose):
@@ -93,13 +106,15 @@ class Aperture:
     @classmethod
     def grid(cls, n: int, pitch: float, *, ny: int | None = None, pitch_y: float | None = None,
              center: tuple[float, float] = (0.0, 0.0), monostatic: bool = False,
-             pose: Pose | None = None, polarization: Any = None) -> Aperture:
+             pose: Pose | None = None, polarization: Any = None,
+             tx_offset: Any = None) -> Aperture:
         """A regular ``ny x n`` grid centred on ``center``: ``x_i = (i - (n-1)/2)*pitch``.
 
         ``monostatic=True`` makes it the scan grid of one transceiver; ``pose``
         places and tilts its plane (``center`` is then in the aperture's own
         coordinates; the pose's centre is the world position of their origin);
-        ``polarization`` is the recorded field component (world axes).
+        ``polarization`` is the recorded field component (world axes);
+        ``tx_offset`` a transmitter moving beside the scanned receiver, metres.
 
         Examples
         --------
@@ -116,7 +131,7 @@ class Aperture:
         x = (np.arange(int(n)) - (int(n) - 1) / 2) * pitch + center[0]
         y = (np.arange(ny) - (ny - 1) / 2) * py + center[1]
         return cls(x, y, monostatic=monostatic, pose=pose or IDENTITY,
-                   polarization=polarization)
+                   polarization=polarization, tx_offset=tx_offset)
 
     @classmethod
     def paper(cls) -> Aperture:

@@ -154,6 +154,14 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
     if mono and include_direct:
         raise ValueError("include_direct has no meaning for a monostatic aperture (a "
                          "transceiver's coupling to itself is not modelled)")
+    offset = getattr(aperture, "tx_offset", None)
+    if offset is not None and pol is not None:
+        raise ValueError("polarization: the vector model of a transmitter beside the "
+                         "receiver (aperture.tx_offset) is not modelled; give "
+                         "polarization=None (the scalar model)")
+    if offset is not None and not _pose_is_identity(aperture):
+        raise ValueError("aperture.tx_offset is modelled on an untilted aperture at z = 0 "
+                         "(pose the identity)")
     if mono and any(isinstance(t, PlanarTarget) for t in scene.targets):
         raise ValueError("planar targets are not modelled for a monostatic aperture (each "
                          "transceiver would need its own Kirchhoff integral); use point "
@@ -171,7 +179,8 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
             total = _bistatic_vector(k, medium, scene, pts, pol, include_targets,
                                      include_surface, include_direct)
         elif mono:
-            total = _monostatic(k, medium, scene, pts, include_targets, include_surface)
+            total = _monostatic(k, medium, scene, pts, include_targets, include_surface,
+                                offset)
         else:
             total = _bistatic(k, medium, scene, pts, include_targets, include_surface,
                               include_direct)
@@ -187,7 +196,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         return Hologram(data.reshape(shape), aperture.x, aperture.y,
                         freqs if wide else float(freqs[0]),
                         source=None if mono else source, monostatic=mono, pose=aperture.pose,
-                        polarization=pol)
+                        polarization=pol, tx_offset=offset)
     return data
 
 
@@ -347,9 +356,13 @@ def _bistatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray, include_t
 
 
 def _monostatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
-                include_targets: bool, include_surface: bool) -> np.ndarray:
-    """Scanned transceivers: each element's echo of its own point-source wave."""
+                include_targets: bool, include_surface: bool,
+                offset: tuple[float, float, float] | None = None) -> np.ndarray:
+    """Scanned transceivers: each element's echo of its own point-source wave; with
+    ``offset``, of a transmitter at the element + offset (``g_rx g_tx``)."""
     total = np.zeros(len(pts), complex)
+    if offset is not None:
+        return _offset_pair(k, medium, scene, pts, include_targets, include_surface, offset)
     if include_targets:
         targets = _scalar_points(k, medium, scene.targets)
         for zt in sorted({float(t.position[2]) for t in targets}):
@@ -373,6 +386,36 @@ def _monostatic(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
             total[sel] += green_at_distances(k, medium, float(zr), float(zr), np.zeros(1),
                                              kind="reflected")[0]
     return total
+
+
+def _offset_pair(k: float, medium: Medium, scene: Scene, pts: np.ndarray,
+                 include_targets: bool, include_surface: bool,
+                 offset: tuple[float, float, float]) -> np.ndarray:
+    """A receiver at each element and a transmitter at the element + ``offset``: a
+    point target returns ``a g(rx, t) g(tx, t)`` (Born), the surface the transmitter's
+    reflected wave at the receiver."""
+    dx, dy, dz = offset
+    total = np.zeros(len(pts), complex)
+    if include_targets:
+        targets = _scalar_points(k, medium, scene.targets)
+        for t in targets:
+            zt = float(t.position[2])
+            legs = []
+            for shift, zr in (((0.0, 0.0), 0.0), ((dx, dy), dz)):
+                rho = np.hypot(pts[:, 0] + shift[0] - t.position[0],
+                               pts[:, 1] + shift[1] - t.position[1])
+                legs.append(green_at_distances(k, medium, zt, zr, rho))
+            total += t.amplitude * legs[0] * legs[1]
+    if include_surface and not medium.is_free_space:
+        glare = green_at_distances(k, medium, float(dz), 0.0, np.array([np.hypot(dx, dy)]),
+                                   kind="reflected")[0]
+        total += glare
+    return total
+
+
+def _pose_is_identity(aperture: object) -> bool:
+    pose = getattr(aperture, "pose", None)
+    return pose is None or pose.is_identity
 
 
 def _point_targets(k: float, medium: Medium, source: object, targets: list[PointTarget],

@@ -68,6 +68,10 @@ class FrameGeometry:
         shape_problem = _shape_problem(holo)
         if shape_problem:
             raise ValueError(shape_problem)
+        if getattr(holo, "tx_offset", None) is not None:
+            raise ValueError("a survey's frames are transceivers or receiver arrays: a frame "
+                             f"with tx_offset {holo.tx_offset} m (a transmitter beside the "
+                             "receiver) is imaged on its own, with migrate or invert")
         dx, dy = holo.pitch
         return cls(int(holo.shape[-2]), int(holo.shape[-1]), (float(dx), float(dy)),
                    tuple(float(f) for f in holo.frequencies), bool(holo.is_wideband),

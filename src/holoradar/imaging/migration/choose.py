@@ -8,6 +8,8 @@ functions cached, or the phase step from plane to plane when they would not fit 
 the cache; for ``frame="ground"`` the finufft sum where the measured costs favour
 it, else the direct one. ``"stolt"`` (an approximation) is taken only when asked.
 A backend asked for by name that refuses raises a ``ValueError`` with its reason.
+A hologram with a transmitter beside the receiver (``tx_offset``) has one backend,
+``"offset"``, whose two-leg kernel no other backend models.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import math
 from ...physics.propagation import transfer_cache_bytes
 from .backend import Backend
 from .ground import GroundDirect, GroundNufft
+from .offset import Offset
 from .phase_shift import Columns, PhaseShift, Stolt
 from .plan import MigrationPlan
 from .planes import FresnelPlanes, PlaneByPlane
@@ -26,7 +29,7 @@ __all__ = ["BACKENDS", "choose"]
 #: Every backend by name.
 BACKENDS: dict[str, Backend] = {b.name: b for b in (
     PlaneByPlane(), FresnelPlanes(), PhaseShift(), Columns(), Stolt(), GroundDirect(),
-    GroundNufft())}
+    GroundNufft(), Offset())}
 
 
 def choose(plan: MigrationPlan) -> Backend:
@@ -39,6 +42,16 @@ def choose(plan: MigrationPlan) -> Backend:
         says what it needs.
     """
     name = plan.settings.algorithm
+    if plan.geometry.tx_offset is not None:
+        offset = BACKENDS["offset"]
+        if name not in ("auto", "frequency", "offset"):
+            raise ValueError(f"algorithm={name!r} does not model a transmitter beside the "
+                             "receiver (hologram.tx_offset): use 'auto' (or 'offset')")
+        why = offset.refuses(plan)
+        if why is not None:
+            raise ValueError(f"a hologram with tx_offset is imaged by its two-leg kernel, "
+                             f"which needs {why}")
+        return offset
     if name == "auto":
         candidates = _preferences(plan)
     elif name == "frequency":

@@ -111,8 +111,9 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
         raise ValueError(f"sampling must be 'auto', 'band' or 'array', got {sampling!r}")
     u = oversampling(hologram) if s.frame == "aperture" and isinstance(hologram, Hologram) \
         else 1
-    if sampling == "band" or (sampling == "auto" and s.scatterer != "point"):
-        u = 1
+    if sampling == "band" or (sampling == "auto" and s.scatterer != "point") \
+            or getattr(hologram, "tx_offset", None) is not None:
+        u = 1   # (the two-leg kernel samples the elements exactly: offset.py)
     if u > 1:
         if s.compensate_loss:
             raise ValueError("sampling='array' models the field, not migrate's filter: give "
@@ -241,7 +242,7 @@ class MigrationOperator(LinearOperator):
         g = self.geometry
         return Hologram(np.asarray(v).reshape(self.data_shape), g.x, g.y, g.frequency,
                         source=g.source, monostatic=g.monostatic, pose=g.pose,
-                        polarization=g.polarization)
+                        polarization=g.polarization, tx_offset=g.tx_offset)
 
     def vector(self, hologram: Hologram) -> np.ndarray:
         """A hologram of this geometry (one frame) as the flat vector ``A.H`` takes."""

@@ -47,7 +47,7 @@ def fine_hologram(hologram: Hologram, u: int) -> Hologram:
     data = zero_insert(hologram.data, u, (y.size, x.size))
     return Hologram(data, x, y, hologram.frequency, source=hologram.source,
                     monostatic=hologram.monostatic, pose=hologram.pose,
-                    polarization=hologram.polarization)
+                    polarization=hologram.polarization, tx_offset=hologram.tx_offset)
 
 
 def decimate(fine: np.ndarray, u: int) -> np.ndarray:

@@ -21,7 +21,7 @@ __all__ = ["ALGORITHMS", "ILLUMINATIONS", "MigrationSettings", "check_choice",
 
 #: ``algorithm=`` values: ``"auto"`` or a backend's name.
 ALGORITHMS = ("auto", "frequency", "kspace", "columns", "stolt", "fresnel", "ground-direct",
-              "ground-nufft")
+              "ground-nufft", "offset")
 
 #: ``illumination=`` values: what the forward model multiplies a reflectivity by.
 ILLUMINATIONS = ("none", "phase", "field")
