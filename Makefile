@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint bench clean browser screenshots
+.PHONY: demo test test-slow lint bench clean browser cf-units screenshots
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -33,6 +33,22 @@ browser:
 	else echo "$(BROWSER_PKGS) missing and not installable here: the browser tests will skip"; \
 	fi
 
+# The CF conventions checker (cfchecker, in the test extras) loads the UDUNITS-2 C library:
+# Debian's libudunits2-0, installed here when missing and this user may; where it cannot
+# be, the checker's test skips and says why.
+UDUNITS_PKG := libudunits2-0
+cf-units:
+	@if ldconfig -p 2>/dev/null | grep -q libudunits2; then :; \
+	elif [ "$$(id -u)" = 0 ]; then \
+	  (apt-get install -y -q $(UDUNITS_PKG) >/dev/null 2>&1 || \
+	   (apt-get update -q >/dev/null 2>&1 && apt-get install -y -q $(UDUNITS_PKG) >/dev/null)) \
+	  || echo "could not install $(UDUNITS_PKG): the CF checker's test will skip"; \
+	elif sudo -n true 2>/dev/null; then \
+	  sudo -n apt-get install -y -q $(UDUNITS_PKG) >/dev/null \
+	  || echo "could not install $(UDUNITS_PKG): the CF checker's test will skip"; \
+	else echo "$(UDUNITS_PKG) missing and not installable here: the CF checker's test will skip"; \
+	fi
+
 # The suite runs on every core (pytest-xdist, a test file per worker so that its shared
 # set-up is made once), each worker's BLAS on one thread: two suites' worth of BLAS
 # threads on two cores would only wait on each other.
@@ -46,7 +62,7 @@ PYTEST_PARALLEL := -n auto --dist loadfile
 PYCACHE := PYTHONDONTWRITEBYTECODE=
 PREPARE := $(PYCACHE) $(BIN)/python -m compileall -q -j 0 src tests && \
 	$(PYCACHE) $(BIN)/python -c "from holoradar.imaging import columns; columns.warm()"
-test: $(STAMP) browser
+test: $(STAMP) browser cf-units
 	$(BIN)/ruff check src tests benchmarks examples
 	$(PREPARE)
 	$(PYCACHE) MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q $(PYTEST_PARALLEL)

@@ -176,7 +176,8 @@ def test_file_is_plain_netcdf_with_cf_units(tmp_path):
         v = ds["hologram"]
         assert v.dims == ("frequency", "y", "x", "iq") and v.dtype == np.float64
         assert ds["x"].attrs["units"] == "m" and ds["frequency"].attrs["units"] == "Hz"
-        assert list(ds["iq"].values) == ["I", "Q"]
+        assert ds["iq"].values.tolist() == [0, 1]
+        assert ds["iq"].attrs["flag_meanings"] == "in_phase quadrature"
         np.testing.assert_array_equal(v.values[..., 0] + 1j * v.values[..., 1],
                                       HOLOGRAMS["wideband"].data)
     steps = hr.io.read_history(path)

@@ -13,10 +13,9 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from conftest import crandn
 from holoradar.imaging.migration.linear import migration_operator
 from holoradar.physics.green import green_at_distances
-
-from conftest import crandn
 
 C0 = 299_792_458.0
 OFFSET = (0.12, 0.0, 0.0)
@@ -157,7 +156,7 @@ def test_height_offset_moves_the_transmitter_towards_the_scene():
     h = _point(target, offset=(0.05, 0.0, 0.03))
     p = h.points[0]
     r1 = np.linalg.norm(p - target)
-    r2 = np.linalg.norm(p + [0.05, 0, 0.03] - target)
+    r2 = np.linalg.norm(p + np.array([0.05, 0, 0.03]) - target)
     k = 2 * np.pi * F[0] / C0
     assert h.data[0, 0, 0] == pytest.approx(np.exp(1j * k * (r1 + r2)) / (r1 * r2), rel=1e-12)
     # The operator's kernel holds the same height: a voxel on the target is simulate's.

@@ -57,11 +57,17 @@ def to_dataset(cal: Any) -> Any:
         "noisy": var(yx, cal.noisy.astype(np.int8), "1 = noisy element", "1"),
     }
     coords = {
-        "x": var(("x",), np.asarray(cal.x, float), "element x", "m"),
-        "y": var(("y",), np.asarray(cal.y, float), "element y", "m"),
-        "frequency": var(("frequency",), cal.frequencies, "frequency", "Hz"),
-        "iq": xr.Variable(("iq",), np.array(["I", "Q"]), {"long_name": "I or real part, Q or "
-                                                                       "imaginary part"}),
+        "x": xr.Variable(("x",), np.asarray(cal.x, float), {"long_name": "element x",
+                                                            "units": "m", "axis": "X"}),
+        "y": xr.Variable(("y",), np.asarray(cal.y, float), {"long_name": "element y",
+                                                            "units": "m", "axis": "Y"}),
+        "frequency": xr.Variable(("frequency",), cal.frequencies, {
+            "long_name": "frequency", "units": "Hz", "standard_name": "radiation_frequency"}),
+        # A numeric component with its meanings (CF has no variable-length strings).
+        "iq": xr.Variable(("iq",), np.array([0, 1], np.int8), {
+            "long_name": "component: I or real part, Q or imaginary part", "units": "1",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "in_phase_or_real quadrature_or_imaginary"}),
     }
     attrs: dict[str, Any] = {
         "Conventions": "CF-1.8", "holoradar_kind": "Calibration",

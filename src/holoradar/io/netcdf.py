@@ -5,21 +5,29 @@ Layout of a file:
 * one data variable, ``hologram`` or ``image``, real, with a last dimension
   ``iq`` of size 2: index 0 the in-phase part I, index 1 the quadrature Q, the
   complex sample being ``I + iQ`` (time dependence ``exp(-i omega t)``); no
-  complex type is needed to read it. An image whose values are real (an
+  complex type is needed to read it. The ``iq`` coordinate holds 0 and 1 with
+  ``flag_values`` and ``flag_meanings = "in_phase quadrature"`` (CF has no
+  variable-length string coordinates); An image whose values are real (an
   amplitude map such as a survey's mosaic) is stored as they are, float64 or
   float32, without the ``iq`` dimension, and read back real;
 * its other dimensions: leading frames ``frame0``, ``frame1``, ... , then
   ``frequency`` (a wideband hologram), ``z`` (an image with planes), ``y``, ``x``;
 * coordinates in metres and hertz with CF ``units`` and ``long_name``: ``x``,
-  ``y`` (element coordinates in the aperture's own plane; image pixels in the
-  image's frame), ``z`` (ranges of an image's planes), ``frequency`` (always a
-  1-D variable; ``wideband`` says whether it is an axis);
+  ``y`` (``axis`` X and Y: element coordinates in the aperture's own plane; image
+  pixels in the image's frame), ``z`` (``axis`` Z, ``positive = "down"``: ranges
+  of an image's planes), ``frequency`` (``standard_name = "radiation_frequency"``);
+  a single frequency, or the single plane of an image without a plane axis, is a
+  scalar coordinate (no dimension of length one; files of earlier versions held
+  them as 1-D variables and read alike);
 * global attributes: ``holoradar_kind`` (``Hologram`` or ``Image``),
   ``holoradar_conventions`` (the version of these conventions), ``monostatic``,
   the pose (``pose_center_m``, ``pose_tilt_rad``, ``pose_azimuth_rad``), the
-  source as JSON (``source``), the image's ``method`` and ``has_z_axis``, and a
-  processing ``history`` (JSON list of steps: name, parameters, holoradar's
-  version, UTC time);
+  source as JSON (``source``) and its type (``source_type``), a transmitter
+  beside the receiver (``tx_offset_m``, three numbers), the image's ``method`` and
+  ``has_z_axis``, the ground of the last step that named one as numbers
+  (``ground`` "layered" or "free space"; ``ground_z_interfaces_m`` top-down,
+  ``ground_eps_real`` and ``ground_eps_imag`` from the air down), and a processing
+  ``history`` (JSON list of steps: name, parameters, holoradar's version, UTC time);
 * ``polarization`` (a hologram that records one field component): three numbers,
   the unit vector (x, y, z) in world axes (the medium's frame, not the aperture's
   own) of the electric-field component the elements record, e.g. ``[0, 1, 0]``
@@ -141,11 +149,48 @@ def _split_iq(data: np.ndarray) -> np.ndarray:
     return np.stack([data.real, data.imag], axis=-1).astype(real, copy=False)
 
 
-def _coord(values: np.ndarray, dim: str, units: str, long_name: str) -> Any:
+def _coord(values: np.ndarray, dim: str, units: str, long_name: str,
+           axis: str | None = None) -> Any:
     import xarray as xr
 
-    return xr.Variable((dim,), np.asarray(values, float), {"units": units,
-                                                          "long_name": long_name})
+    attrs = {"units": units, "long_name": long_name}
+    if axis is not None:
+        attrs["axis"] = axis
+    return xr.Variable((dim,), np.asarray(values, float), attrs)
+
+
+def _frequency(obj: Any) -> Any:
+    """The frequency coordinate: an axis of a band, a scalar coordinate of one."""
+    import xarray as xr
+
+    attrs = {"units": "Hz", "long_name": "frequency", "standard_name": "radiation_frequency"}
+    f = obj.frequency
+    if isinstance(f, np.ndarray):
+        return xr.Variable(("frequency",), np.asarray(f, float), attrs)
+    return xr.Variable((), float(f), attrs)
+
+
+def _ground_attributes(steps: list[Any]) -> dict[str, Any]:
+    """The ground of the last step that names one (``parameters.medium``) as numbers:
+    ``ground_z_interfaces_m`` (top-down), ``ground_eps_real`` and ``ground_eps_imag``
+    (the air first: one more than the interfaces); a step whose medium is null: free
+    space (``ground = "free space"``)."""
+    for step in reversed(steps):
+        params = step.get("parameters") if isinstance(step, dict) else None
+        if not isinstance(params, dict) or "medium" not in params:
+            continue
+        m = params["medium"]
+        if m is None:
+            return {"ground": "free space"}
+        try:
+            eps = [complex(str(e).replace(" ", "")) for e in m["eps"]]
+            zi = [float(z) for z in m["z_interfaces"]]
+        except (KeyError, TypeError, ValueError):
+            return {}
+        return {"ground": "layered", "ground_z_interfaces_m": np.asarray(zi, float),
+                "ground_eps_real": np.asarray([e.real for e in eps], float),
+                "ground_eps_imag": np.asarray([e.imag for e in eps], float)}
+    return {}
 
 
 def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = None) -> Any:
@@ -172,14 +217,19 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
                              "iq_convention": "sample = I + iQ (iq index 0, 1); time "
                                               "dependence exp(-i omega t)"}
     coords: dict[str, Any] = {
-        "iq": xr.Variable(("iq",), np.array(["I", "Q"]), {"long_name": "in-phase, quadrature"}),
-        "frequency": _coord(np.atleast_1d(obj.frequency), "frequency", "Hz", "frequency"),
+        # CF has no string coordinates of variable length: the component is a small
+        # integer whose meaning flag_values/flag_meanings say.
+        "iq": xr.Variable(("iq",), np.array([0, 1], np.int8), {
+            "long_name": "component of the complex sample: in-phase I, quadrature Q",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "in_phase quadrature", "units": "1"}),
+        "frequency": _frequency(obj),
     }
     if isinstance(obj, Hologram):
         kind, var = "Hologram", "hologram"
         core = (["frequency"] if obj.is_wideband else []) + ["y", "x"]
-        coords["x"] = _coord(obj.x, "x", "m", "element x in the aperture's own plane")
-        coords["y"] = _coord(obj.y, "y", "m", "element y in the aperture's own plane")
+        coords["x"] = _coord(obj.x, "x", "m", "element x in the aperture's own plane", "X")
+        coords["y"] = _coord(obj.y, "y", "m", "element y in the aperture's own plane", "Y")
         p = obj.pose
         attrs.update(monostatic=int(obj.monostatic), wideband=int(obj.is_wideband),
                      pose_center_m=np.asarray(p.center, float), pose_tilt_rad=float(p.tilt),
@@ -187,6 +237,7 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
         src = source_to_json(obj.source)
         if src is not None:
             attrs["source"] = src
+            attrs["source_type"] = type(obj.source).__name__
         if obj.polarization is not None:
             attrs["polarization"] = np.asarray(obj.polarization, float)
         if obj.tx_offset is not None:
@@ -195,9 +246,14 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     elif isinstance(obj, Image):
         kind, var = "Image", "image"
         core = (["z"] if obj.has_z_axis else []) + ["y", "x"]
-        coords["x"] = _coord(obj.x, "x", "m", "pixel x")
-        coords["y"] = _coord(obj.y, "y", "m", "pixel y")
-        coords["z"] = _coord(obj.z, "z", "m", "range of the image planes")
+        coords["x"] = _coord(obj.x, "x", "m", "pixel x", "X")
+        coords["y"] = _coord(obj.y, "y", "m", "pixel y", "Y")
+        z = np.asarray(obj.z, float)
+        zattrs = {"units": "m", "long_name": "range of the image planes from the aperture",
+                  "axis": "Z", "positive": "down"}
+        # A single plane without a plane axis: a scalar coordinate (no unused dimension).
+        coords["z"] = xr.Variable(("z",), z, zattrs) if obj.has_z_axis else \
+            xr.Variable((), float(z.ravel()[0]), zattrs)
         attrs.update(method=str(obj.method), has_z_axis=int(obj.has_z_axis),
                      wideband=int(isinstance(obj.frequency, np.ndarray)))
         long_name = "reconstructed field"
@@ -210,6 +266,7 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
                   "time": now})
     attrs["holoradar_kind"] = kind
     attrs["history"] = json.dumps(steps)
+    attrs.update(_ground_attributes(steps))
     if kind == "Image" and not np.iscomplexobj(data):
         # A real image (an amplitude map): its values as they are, not I and Q = 0 at
         # twice the size read back as complex.
