@@ -39,7 +39,8 @@ DECISIVE_RATIO = 3.0
 sides: the peak-to-mean intensity of N independent cells is ``ln N + 0.58`` with a
 spread of 1.28 (the Gumbel law of the largest of N exponential intensities), so one
 side reaches 3 times the other's ``ln N + 0.58`` with probability about
-``exp(-2 ln N - 1.2) = 0.3/N^2``: below 1e-3 from N = 18 cells on. A focused point
+``exp(-2 ln N - 1.2) = 0.3/N^2``: below 1e-3 from N = 18 cells on (at each of the
+check's two stages: twice that for both). A focused point
 is tens to hundreds of times sharper than its conjugate (tests/test_iq_sign.py)."""
 
 PAD = 2.0
@@ -61,6 +62,9 @@ most 256 x 256 whatever the array."""
 MAX_FRAMES = 4
 """Frames (views, repeats) the check looks at, spread over those the data hold."""
 
+MAX_BAND = 64
+"""Frequencies of the second stage, the band's coherent image (spread over the band)."""
+
 
 class IQSignWarning(UserWarning):
     """The data focus behind the array: recorded as ``I - iQ`` (their complex conjugate)."""
@@ -78,7 +82,8 @@ class IQSignCheck:
     ratio : float
         Peak-to-mean intensity of the data as recorded over that of their
         conjugate (the mirror scene behind the aperture): >> 1 for ``I + iQ``,
-        << 1 for ``I - iQ``.
+        << 1 for ``I - iQ``; of the stage that decided (the frequencies alone, or
+        the band's coherent image), or of the first when neither did.
     z : tuple of float
         The ranges imaged, metres.
     reason : str
@@ -116,6 +121,39 @@ def _reduced(hologram: Hologram) -> Hologram:
     peak = float(np.max(np.abs(data))) if data.size else 0.0
     return hologram.replace(data=data / peak if peak > 0 else data, x=hologram.x[x0:x1],
                             y=hologram.y[y0:y1])
+
+
+def _reduced_band(hologram: Hologram) -> Hologram:
+    """The band's data cut as :func:`_reduced` cuts one frequency's: at most
+    :data:`MAX_BAND` frequencies (spread over the band), :data:`MAX_FRAMES` frames and
+    the central :data:`MAX_ELEMENTS` x :data:`MAX_ELEMENTS` elements."""
+    nf, ny, nx = hologram.data.shape[-3:]
+    keep = _spread(np.arange(nf), MAX_BAND)
+    data = hologram.data.reshape((-1, nf, ny, nx))
+    data = data[_spread(np.arange(data.shape[0]), MAX_FRAMES)][:, keep]
+    y0, x0 = max(0, (ny - MAX_ELEMENTS) // 2), max(0, (nx - MAX_ELEMENTS) // 2)
+    y1, x1 = min(ny, y0 + MAX_ELEMENTS), min(nx, x0 + MAX_ELEMENTS)
+    data = data[..., y0:y1, x0:x1]
+    peak = float(np.max(np.abs(data))) if data.size else 0.0
+    return hologram.replace(data=data / peak if peak > 0 else data, x=hologram.x[x0:x1],
+                            y=hologram.y[y0:y1], frequency=hologram.frequencies[keep])
+
+
+def _band_sides(hologram: Hologram, zs: np.ndarray, opts: dict[str, Any]) -> list[float]:
+    """The sharpness of the band's coherent image, as recorded and conjugated (the
+    frequencies weighted alike, ``equalize=True``): a point focuses in range too, so
+    data each of whose frequencies is too faint to decide alone may decide together
+    (the coherent sum's gain, ``10 log10(nf)`` dB over one frequency)."""
+    band = _reduced_band(hologram)
+    out = []
+    for flip in (False, True):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            img = migrate(conjugate(band) if flip else band, zs, upsample=1, pad=PAD,
+                          progress=False, combine="coherent", **opts)
+        a = np.abs(np.asarray(img.data)) ** 2
+        out.append(_sharpness(np.sqrt(a.reshape((-1, *a.shape[-3:])).sum(axis=0))))
+    return out
 
 
 def _without_direct_wave(hologram: Hologram) -> Hologram:
@@ -157,8 +195,12 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
 
     Back-propagates the data and their conjugate (the field of the mirror scene
     behind the aperture) to the same ranges and compares the sharpness of their
-    foci; decides only when one is :data:`DECISIVE_RATIO` times sharper. Cheap:
-    at most :data:`MAX_PLANES` planes, :data:`MAX_FREQUENCIES` frequencies,
+    foci; decides only when one is :data:`DECISIVE_RATIO` times sharper. First each
+    of at most :data:`MAX_FREQUENCIES` frequencies alone (intensities added: a
+    device's phase response across the band does not matter); where that does not
+    decide, the band's coherent image (at most :data:`MAX_BAND` frequencies), whose
+    range focus and coherent gain decide on fainter or more extended scenes, as
+    :func:`iq_convention` does. Cheap: at most :data:`MAX_PLANES` planes,
     :data:`MAX_FRAMES` frames and the central :data:`MAX_ELEMENTS` x
     :data:`MAX_ELEMENTS` elements, one pixel per element.
 
@@ -229,19 +271,38 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
     if not (sides[0] > 0 and sides[1] > 0):  # data all zero: nothing to compare
         return IQSignCheck(None, float("nan"), planes, "the data are zero")
     ratio = sides[0] / sides[1]
-    sign: Literal["I+iQ", "I-iQ"] | None = None
-    if ratio >= DECISIVE_RATIO:
-        sign = "I+iQ"
-    elif ratio <= 1 / DECISIVE_RATIO:
-        sign = "I-iQ"
+    sign = _verdict(ratio)
+    band_ratio = None
+    if sign is None and hologram.nf > 1:
+        # Second stage: the band's coherent image (range focus; the coherent gain).
+        try:
+            band = _band_sides(hologram, zs, opts)
+        except ValueError:
+            band = [0.0, 0.0]
+        if band[0] > 0 and band[1] > 0:
+            band_ratio = band[0] / band[1]
+            sign = _verdict(band_ratio)
+            if sign is not None:
+                return IQSignCheck(sign, float(band_ratio), planes)
+    coherent = "" if band_ratio is None else (
+        f", and the band's {min(hologram.nf, MAX_BAND)} frequencies imaged together "
+        f"{band_ratio:.2f} (a device whose phase response across the band is not "
+        "calibrated blurs that image on both sides)")
     why = "" if sign is not None else (
         f"the data and their conjugate focus alike at {min(planes):.3g} to {max(planes):.3g} m "
-        f"(sharpness ratio {ratio:.2f}, a verdict needs {DECISIVE_RATIO:g} or "
-        f"1/{DECISIVE_RATIO:g}): nothing compact there, each of "
-        f"{min(hologram.nf, MAX_FREQUENCIES)} frequencies judged alone; give z where a "
-        "compact reflector (or the radiating antenna) lies, or compare the band's "
-        "coherent foci at those ranges with iq_convention(hologram, z)")
+        f"(sharpness ratio {ratio:.2f} with each of {min(hologram.nf, MAX_FREQUENCIES)} "
+        f"frequencies judged alone{coherent}; a verdict needs {DECISIVE_RATIO:g} or "
+        f"1/{DECISIVE_RATIO:g}): nothing compact there, or mostly noise; give z where a "
+        "compact reflector (or the radiating antenna) lies")
     return IQSignCheck(sign, float(ratio), planes, why)
+
+
+def _verdict(ratio: float) -> Literal["I+iQ", "I-iQ"] | None:
+    if ratio >= DECISIVE_RATIO:
+        return "I+iQ"
+    if ratio <= 1 / DECISIVE_RATIO:
+        return "I-iQ"
+    return None
 
 
 def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
