@@ -175,3 +175,14 @@ def test_hologram_that_did_not_make_the_image_is_refused():
     img = hr.migrate(h, 0.42, medium=sand, upsample=4)
     with pytest.raises(ValueError, match="image is not migrate"):
         detect(img, hologram=h)              # migrated through sand, checked in air
+
+
+def test_reference_noise_of_an_image_smaller_than_the_guard_box():
+    """A frame's image smaller than the guard cells around a candidate: the reference is
+    the image's own mean power (finite, never 0/0)."""
+    from holoradar.analysis.detect.reference import candidate_noise
+
+    r = np.full((1, 5, 5), 2.0 + 0j)
+    s2, n = candidate_noise(r, np.zeros((5, 5), bool), (0, 2, 2), np.arange(5.0) * 0.01,
+                            np.arange(5.0) * 0.01, (0.05, 0.05, np.inf))
+    assert s2 == 4.0 and n >= 1.0

@@ -213,7 +213,9 @@ def test_info_describes_a_survey_store(survey: list[Path], tmp_path: Path) -> No
     idx = survey_store.read_index(store)
     slot = int(np.nonzero(idx["done"])[0][1])
     (store / "image" / "c" / str(slot) / "0" / "0" / "0" / "0").unlink()
-    d = json.loads(run("info", store, "--json").stdout)
+    res = run("info", store, "--json", ok=False)
+    assert res.exit_code == 2 and idx["frame_name"][slot] in res.stderr
+    d = json.loads(res.stdout)
     assert d["frames_stored"] == 5 and d["frames_expected"] == 8
     assert d["damaged"] == [{"name": idx["frame_name"][slot], "path": idx["frame_path"][slot],
                              "reason": "marked done but its image chunk is missing"}]
@@ -239,3 +241,36 @@ def test_mosaic_file_is_an_amplitude_and_one_panel_says_so(survey: list[Path],
     assert [a.get_ylabel() for a in fig.axes[1:]] == ["|E| / max"]
     fig = plotting.plot_planes(hr.migrate(hr.load(survey[0]), [0.3, 0.4]), [0.3, 0.4])
     assert [a.get_ylabel() for a in fig.axes[2:]] == ["|E| / max (all panels)"]
+
+
+@pytest.mark.parametrize("damage", ["truncate", "remove", "flip"])
+def test_every_command_names_a_damaged_frame_with_exit_2(survey: list[Path], tmp_path: Path,
+                                                         damage: str) -> None:
+    """A frame's image chunk truncated, missing or with a flipped bit: mosaic, detect (on
+    the frames' holograms, or one plane of the images), report and info answer with the
+    frame's name and exit code 2 (no crash in the decompressor, no blank hole)."""
+    store = tmp_path / "s.zarr"
+    hr.survey.run_batch(survey[:3], store, z=[0.3], scheduler="synchronous")
+    idx = survey_store.read_index(store)
+    slot = int(np.nonzero(idx["done"])[0][1])
+    name = str(idx["frame_name"][slot])
+    chunk = store / "image" / "c" / str(slot) / "0" / "0" / "0" / "0"
+    blob = bytearray(chunk.read_bytes())
+    if damage == "remove":
+        chunk.unlink()
+    elif damage == "truncate":
+        chunk.write_bytes(bytes(blob[: len(blob) // 2]))
+    else:
+        blob[len(blob) // 2] ^= 0x10
+        chunk.write_bytes(bytes(blob))
+    for args in (("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc"),
+                 ("detect", store), ("detect", store, "--z", "0.3"),
+                 ("report", store, "-o", tmp_path / "r.html"), ("info", store)):
+        res = run(*args, ok=False)
+        assert res.exit_code == 2, (args[0], res.output)
+        assert name in res.output and "Traceback" not in res.output, (args[0], res.output)
+    assert not (tmp_path / "map.nc").exists() and not (tmp_path / "r.html").exists()
+    # A rerun of the batch images the damaged frame again: every command reads it.
+    hr.survey.run_batch(survey[:3], store, z=[0.3], scheduler="synchronous")
+    run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc")
+    run("info", store)

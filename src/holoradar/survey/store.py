@@ -584,6 +584,18 @@ def read_images(index: dict[str, Any], frames: Sequence[int],
         raw = img.oindex[sel] if plane is None else img.oindex[sel, int(plane)]
     except Exception as exc:  # a damaged chunk (its checksum, its codec): name its frames
         raise ValueError(_damaged_frames(index, img, sel, exc)) from None
+    # A missing chunk reads as the fill value (NaN): a frame marked done without its
+    # image, named (a written image is finite: the batch refuses others).
+    done = index.get("done")
+    empty = [int(i) for i, r in zip(sel, raw, strict=True)
+             if done is not None and bool(done[int(i)]) and not np.all(np.isfinite(r))]
+    if empty:
+        names = ", ".join(str(index["frame_name"][i]) for i in empty)
+        where = index.get("path", "the survey store")
+        raise ValueError(f"store {str(where)!r}: frame(s) {names} damaged (marked done but "
+                         "the image chunk is missing or holds no numbers): image them "
+                         "again with holoradar batch (a rerun repairs them), or search the "
+                         "others")
     out = np.empty(raw.shape[:-1], np.complex64 if raw.dtype == np.float32 else complex)
     out.real = raw[..., 0]
     out.imag = raw[..., 1]
@@ -613,9 +625,11 @@ def _damaged_frames(index: dict[str, Any], img: Any, sel: np.ndarray, exc: Excep
             bad.append(str(index["frame_name"][int(i)]))
     names = ", ".join(bad) if bad else "some"
     where = index.get("path", "the survey store")
-    return (f"store {str(where)!r}: frame(s) {names} damaged ({type(exc).__name__}: "
-            f"{' '.join(str(exc).split())[:160]}): image them again with holoradar batch "
-            "(their frames' files), or search the others")
+    text = " ".join(str(exc).split())
+    why = ("the image chunk fails its CRC-32C checksum: damaged on disk"
+           if "checksum" in text.lower() else f"{type(exc).__name__}: {text[:160]}")
+    return (f"store {str(where)!r}: frame(s) {names} damaged ({why}): image them again "
+            "with holoradar batch (a rerun repairs them), or search the others")
 
 
 def stored_crs(target: Path) -> Any:

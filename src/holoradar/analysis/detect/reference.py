@@ -48,6 +48,10 @@ def candidate_noise(residual: np.ndarray, mask: np.ndarray, index: tuple[int, in
     w = np.where(guard | mask, 0.0, w)
     if w.sum() <= 0:
         w = np.where(guard, 0.0, 1.0)
+    if w.sum() <= 0:
+        # The guard box covers the whole (small) image: its own mean power, the
+        # candidate's peak included (a higher reference: fewer objects, never 0/0).
+        w = np.ones_like(w)
     p = np.abs(residual[iz]) ** 2
     s2 = float(np.sum(w * p) / np.sum(w))
     per_cell = cell[0] * cell[1] / (dx * dy)

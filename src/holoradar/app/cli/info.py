@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 import textwrap
 from pathlib import Path
 from typing import Any
@@ -61,13 +62,25 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
     """Show what FILE holds: its variables, and the hologram or image read from it.
 
     FILE may also be a survey store (a .zarr folder written by holoradar batch): its
-    frames stored and missing, planes, grid and settings.
+    frames stored and missing, planes, grid and settings; a store with damaged frames
+    (a chunk missing or failing its checksum) is described, its damaged frames named,
+    and the command exits with code 2.
     """
     if file.is_dir():
         from .batch import store_info
 
-        report.done(*store_info(file))
-        return
+        summary, lines = store_info(file)
+        if not summary["damaged"]:
+            report.done(summary, lines)
+            return
+        # Described, the damage said as the answer (one line on stderr), exit code 2;
+        # with --json one object on stdout: the description with the error in it.
+        names = ", ".join(m["name"] for m in summary["damaged"])
+        msg = (f"store {file.name!r}: {len(summary['damaged'])} damaged frame(s): {names}: "
+               "image them again with holoradar batch (a rerun repairs them)")
+        report.done({**summary, "error": msg, "exit_code": 2}, lines)
+        click.echo(f"error: {msg}", err=True)
+        sys.exit(2)
     from ...io import load, read_history
     from ...io.readers import read_variables
 
