@@ -39,3 +39,13 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         terminalreporter.write_sep("-", "fuzzing: inputs tried")
         for name, n in sorted(FUZZED.items()):
             terminalreporter.write_line(f"{n:6d}  {name}")
+
+
+def migrate64(*args, **kwargs):
+    """``hr.migrate`` in double precision unless a dtype is given: the tests that compare
+    an image with closed forms or with another path to 1e-10 test the arithmetic, not the
+    single-precision default (whose own accuracy, 1e-6 of double, has its test)."""
+    import holoradar as hr
+
+    kwargs.setdefault("dtype", np.complex128)
+    return hr.migrate(*args, **kwargs)

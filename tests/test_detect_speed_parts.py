@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from conftest import migrate64
 from holoradar.analysis.detect import noise as nz_noise
 from holoradar.analysis.detect.grid import as_volume
 from holoradar.analysis.detect.model import HologramModel
@@ -143,7 +144,7 @@ def small():
     scene = hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget((0.01, -0.005, 0.17))])
     h = hr.simulate(scene, hr.Aperture.grid(16, 0.01, monostatic=True),
                     np.linspace(8e9, 12e9, 3), include_surface=False, snr_db=20, seed=5)
-    img = hr.migrate(h, np.linspace(0.13, 0.21, 20), medium=sand, upsample=2)
+    img = migrate64(h, np.linspace(0.13, 0.21, 20), medium=sand, upsample=2)
     return h, img, sand
 
 
@@ -205,11 +206,11 @@ def test_objects_image_is_the_frozen_migration_of_the_response(small):
     plan = model.migration.plan
     g = model.response(np.array([0.0, 0.01, 0.18]))
     fast = model.image(g)
-    slow = hr.migrate(h.with_data(g.reshape(h.data.shape)), img.z, medium=sand, upsample=2,
+    slow = migrate64(h.with_data(g.reshape(h.data.shape)), img.z, medium=sand, upsample=2,
                       equalize=plan.weights, snr_db=plan.snr_db, algorithm="frequency").data
     assert np.allclose(fast, slow, rtol=0, atol=1e-12 * np.abs(slow).max())
     # A plane: the model images that plane alone.
-    plane = hr.migrate(h, float(img.z[5]), medium=sand, upsample=2)
+    plane = migrate64(h, float(img.z[5]), medium=sand, upsample=2)
     single = HologramModel(h, as_volume(plane), sand, {})
     single.start()
     assert single.image(g).shape == (1, *plane.data.shape)

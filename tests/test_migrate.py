@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from conftest import F0
+from conftest import F0, migrate64
 from holoradar import theory
 from holoradar.analysis.metrics import main_lobe_width, peak_position
 
@@ -34,7 +34,7 @@ def test_point_source_focuses_at_its_position():
     h = point_hologram(src, 96, LAM / 2)
     A = 96 * LAM / 2
     assert theory.fresnel_number(A, LAM, 0.5) > 30
-    img = hr.migrate(h, np.linspace(0.47, 0.53, 61), upsample=4)
+    img = migrate64(h, np.linspace(0.47, 0.53, 61), upsample=4)
     x, y, z = peak_position(img)
     assert np.hypot(x - src[0], y - src[1]) < LAM / 20
     assert abs(z - src[2]) < LAM / 4
@@ -48,7 +48,7 @@ def test_main_lobe_width_is_lambda_z_over_a():
     z, n = 2.0, 66
     src = np.array([0.0, 0.0, z])
     h = point_hologram(src, n, LAM / 2)
-    img = hr.migrate(h, z, upsample=8)
+    img = migrate64(h, z, upsample=8)
     iy = int(np.argmin(np.abs(img.y - src[1])))
     delta = main_lobe_width(img.data[iy], img.x) / 2
     expected = theory.lateral_resolution(LAM, z, n * LAM / 2)
@@ -65,8 +65,8 @@ def test_fresnel_agrees_with_angular_in_paraxial_regime():
     # aperture, so the images agree to better than 1% (rms).
     z = 3.0
     h = point_hologram([0.01, -0.005, z], 14, LAM / 2)
-    a = hr.migrate(h, z).data
-    f = hr.migrate(h, z, method="fresnel").data
+    a = migrate64(h, z).data
+    f = migrate64(h, z, method="fresnel").data
     assert np.linalg.norm(a - f) / np.linalg.norm(a) < 0.01
 
 
@@ -75,8 +75,8 @@ def test_fresnel_differs_outside_paraxial_regime():
     # hundreds of radians, so the paraxial image must differ grossly (> 10%).
     z = 0.3
     h = point_hologram([0.0, 0.0, z], 40, LAM / 2)
-    a = hr.migrate(h, z).data
-    f = hr.migrate(h, z, method="fresnel").data
+    a = migrate64(h, z).data
+    f = migrate64(h, z, method="fresnel").data
     assert np.linalg.norm(a - f) / np.linalg.norm(a) > 0.1
 
 
@@ -101,7 +101,7 @@ def test_spectral_window_of_tilted_illumination(tilt_deg):
         rng = np.random.default_rng(seed)
         refl = rng.standard_normal((81, 81)) + 1j * rng.standard_normal((81, 81))
         scene = hr.Scene(source=src, targets=[hr.PlanarTarget(refl, u, u, dist)])
-        g = hr.migrate(hr.simulate(scene, ap, F0), dist).data
+        g = migrate64(hr.simulate(scene, ap, F0), dist).data
         gt = g * np.exp(1j * K * (X**2 + Y**2) / (2 * dist)) * np.exp(-1j * (p0 * X + q0 * Y))
         power += np.abs(np.fft.fftshift(np.fft.fft2(gt, s=(m, m)))) ** 2
     p = np.fft.fftshift(np.fft.fftfreq(m, dx)) * 2 * np.pi
@@ -130,7 +130,7 @@ def test_longitudinal_resolution_matches_migrated_point():
     A = n * LAM / 2
     fw = theory.longitudinal_resolution(LAM, z, A)
     zs = np.linspace(z - 1.2 * fw, z + 1.2 * fw, 241)
-    img = hr.migrate(h, zs)
+    img = migrate64(h, zs)
     on_axis = np.abs(img.data[:, n // 2, n // 2]) ** 2  # even n: the sample nearest 0
     on_axis /= on_axis.max()
     above = zs[on_axis >= 0.5]
@@ -140,20 +140,20 @@ def test_longitudinal_resolution_matches_migrated_point():
 def test_upsample_interpolates_exactly():
     # Zero-padding the spectrum interpolates: every u-th output sample is the original.
     h = point_hologram([0.01, 0.0, 0.4], 24, LAM / 2)
-    a = hr.migrate(h, 0.4).data
-    b = hr.migrate(h, 0.4, upsample=4).data
+    a = migrate64(h, 0.4).data
+    b = migrate64(h, 0.4, upsample=4).data
     np.testing.assert_allclose(b[::4, ::4], a, atol=1e-10 * np.abs(a).max())
 
 
 def test_scalar_and_sequence_shapes():
     h = point_hologram([0.0, 0.0, 0.4], 16, LAM / 2)
-    assert hr.migrate(h, 0.4).data.shape == (16, 16)
-    img = hr.migrate(h, [0.3, 0.4])
+    assert migrate64(h, 0.4).data.shape == (16, 16)
+    img = migrate64(h, [0.3, 0.4])
     assert img.data.shape == (2, 16, 16)
     assert img.z.tolist() == [0.3, 0.4]
     batch = h.with_data(np.stack([h.data, 2 * h.data]))
-    assert hr.migrate(batch, [0.3, 0.4, 0.5]).data.shape == (2, 3, 16, 16)
-    np.testing.assert_allclose(hr.migrate(batch, 0.4).data[1], 2 * hr.migrate(h, 0.4).data)
+    assert migrate64(batch, [0.3, 0.4, 0.5]).data.shape == (2, 3, 16, 16)
+    np.testing.assert_allclose(migrate64(batch, 0.4).data[1], 2 * migrate64(h, 0.4).data)
 
 
 def test_odd_and_rectangular_grids_focus():
@@ -161,7 +161,7 @@ def test_odd_and_rectangular_grids_focus():
     src = np.array([-0.013, 0.021, 0.35])
     R = np.linalg.norm(ap.points - src, axis=1)
     h = hr.Hologram((np.exp(1j * K * R) / R).reshape(33, 41), ap.x, ap.y, F0)
-    img = hr.migrate(h, np.linspace(0.32, 0.38, 31), upsample=4)
+    img = migrate64(h, np.linspace(0.32, 0.38, 31), upsample=4)
     x, y, _ = peak_position(img)
     assert np.hypot(x - src[0], y - src[1]) < LAM / 20
 
@@ -175,7 +175,7 @@ def test_input_is_not_modified():
     before = h.data.copy()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        hr.migrate(h, 0.3)
+        migrate64(h, 0.3)
     np.testing.assert_array_equal(h.data, before)
 
 
@@ -186,11 +186,11 @@ def test_full_field_of_view_sees_beside_the_array():
     # lambda*z/A (3.8 cm): require a quarter. The default view is a crop of the same.
     src = np.array([0.165, -0.03, 0.3])
     h = point_hologram(src, 24, 0.01)
-    full = hr.migrate(h, [0.3], fov="full", upsample=2)
+    full = migrate64(h, [0.3], fov="full", upsample=2)
     x, y, _ = peak_position(full)
     assert x > h.x[-1]  # outside the aperture, where the default view cannot look
     assert np.hypot(x - src[0], y - src[1]) < theory.lateral_resolution(LAM, 0.3, 0.24) / 4
-    crop = hr.migrate(h, [0.3], upsample=2)
+    crop = migrate64(h, [0.3], upsample=2)
     ix = int(np.argmin(np.abs(full.x - crop.x[0])))
     iy = int(np.argmin(np.abs(full.y - crop.y[0])))
     np.testing.assert_allclose(full.data[0, iy:iy + crop.y.size, ix:ix + crop.x.size],
@@ -215,6 +215,6 @@ def test_default_padding_holds_at_long_range(pitch_over_lambda):
     h = hr.Hologram(np.exp(1j * k * R) / R, x, x, F0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        img = hr.migrate(h, 2.0).data
-        ref = hr.migrate(h, 2.0, pad=16.0).data
+        img = migrate64(h, 2.0).data
+        ref = migrate64(h, 2.0, pad=16.0).data
     assert np.linalg.norm(img - ref) / np.linalg.norm(ref) < 0.02

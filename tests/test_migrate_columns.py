@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from conftest import migrate64
 from holoradar.imaging import columns, kspace
 from holoradar.imaging.migration import memory
 from holoradar.imaging.migration import plan as migration_plan
@@ -52,8 +53,8 @@ def _hologram(mono: bool, medium: hr.Medium | None, measured: bool, dtype: type,
     (True, None, False), (True, HALF, True), (False, None, True), (False, HALF, False)])
 def test_auto_equals_the_phase_shift_sum(mono, medium, measured, dtype):
     h = _hologram(mono, medium, measured, dtype)
-    a = hr.migrate(h, ZS, medium=medium)
-    b = hr.migrate(h, ZS, medium=medium, algorithm="kspace")
+    a = migrate64(h, ZS, medium=medium, dtype=dtype)
+    b = migrate64(h, ZS, medium=medium, algorithm="kspace", dtype=dtype)
     assert a.method == b.method == "kspace:coherent"
     assert a.data.dtype == b.data.dtype == dtype and a.data.shape == b.data.shape
     assert _rel(a.data, b.data) < 10 * ZS.size * EPS[dtype]
@@ -68,8 +69,8 @@ def test_auto_equals_the_phase_shift_sum_on_every_grid(pad, upsample, z0):
     h = _hologram(True, None, True, np.complex128)
     h = h.with_data(np.stack([h.data, 0.5j * h.data[::-1]]))
     zs = np.linspace(z0, z0 + 0.12, 17)
-    a = hr.migrate(h, zs, pad=pad, upsample=upsample)
-    b = hr.migrate(h, zs, pad=pad, upsample=upsample, algorithm="kspace")
+    a = migrate64(h, zs, pad=pad, upsample=upsample)
+    b = migrate64(h, zs, pad=pad, upsample=upsample, algorithm="kspace")
     assert a.data.shape == b.data.shape == (2, 17, 24 * upsample - upsample + 1,
                                             24 * upsample - upsample + 1)
     assert _rel(a.data, b.data) < 10 * zs.size * EPS[np.complex128]
@@ -81,10 +82,10 @@ def test_auto_takes_the_compiled_loop_and_the_numpy_sum_without_numba(monkeypatc
     real = columns.adjoint_columns
     monkeypatch.setattr(columns, "adjoint_columns",
                         lambda *a, **k: calls.append(1) or real(*a, **k))
-    a = hr.migrate(h, ZS)
+    a = migrate64(h, ZS)
     assert calls == [1]
     monkeypatch.setattr(columns, "available", lambda: False)
-    b = hr.migrate(h.with_data(h.data), ZS)   # a new hologram: a new plan, chosen afresh
+    b = migrate64(h.with_data(h.data), ZS)   # a new hologram: a new plan, chosen afresh
     assert calls == [1]   # not called again: the NumPy recurrence
     assert _rel(a.data, b.data) < 10 * ZS.size * EPS[np.complex128]
 
@@ -103,7 +104,7 @@ def test_warm_builds_every_loop_a_migration_calls(monkeypatch):
     for dtype in (np.complex64, np.complex128):
         h = _hologram(True, None, False, dtype)
         for pad in (False, True):
-            hr.migrate(h, ZS, pad=pad)
+            migrate64(h, ZS, pad=pad)
     assert set(fresh.signatures) == built
 
 
@@ -112,12 +113,12 @@ def test_auto_falls_back_to_the_per_frequency_sum_where_the_phase_shift_cannot()
     # frequency by frequency (the same code path as "frequency", bit for bit).
     h = _hologram(True, None, False, np.complex128, n=12)
     zs = np.array([0.2, 0.21, 0.23])
-    a = hr.migrate(h, zs)
-    b = hr.migrate(h, zs, algorithm="frequency")
+    a = migrate64(h, zs)
+    b = migrate64(h, zs, algorithm="frequency")
     np.testing.assert_array_equal(a.data, b.data)
     lossy = hr.Medium.layered([0.10, 0.13], [5.0 + 0.5j, 8.0 + 0.3j])
-    a = hr.migrate(h, ZS[::4], medium=lossy)
-    b = hr.migrate(h, ZS[::4], medium=lossy, algorithm="frequency")
+    a = migrate64(h, ZS[::4], medium=lossy)
+    b = migrate64(h, ZS[::4], medium=lossy, algorithm="frequency")
     np.testing.assert_array_equal(a.data, b.data)
 
 
@@ -133,17 +134,17 @@ def test_a_volume_that_does_not_fit_is_refused_before_any_work(monkeypatch):
     monkeypatch.setattr(memory, "available_memory", lambda: 150_000)
     monkeypatch.setattr(memory, "_CHECK_ABOVE", 0)   # checked at any size
     with pytest.raises(MemoryError) as err:
-        hr.migrate(h, ZS)
+        migrate64(h, ZS)
     msg = str(err.value)
     for part in ("29 planes x 24 x 24", "complex128", "0.00 GiB", "fewer planes",
                  "dtype=numpy.complex64", "survey store"):
         assert part in msg
     with pytest.raises(MemoryError, match="fewer planes"):   # the per-frequency sum
-        hr.migrate(h, [0.2, 0.21, 0.23] * 10, algorithm="frequency")
+        migrate64(h, [0.2, 0.21, 0.23] * 10, algorithm="frequency")
     with pytest.raises(MemoryError, match="fewer planes"):   # one frequency
-        hr.migrate(h.at_frequency(0), ZS)
+        migrate64(h.at_frequency(0), ZS)
     assert work == []
     # Enough memory: it runs (the stand-ins record the work).
     monkeypatch.setattr(memory, "available_memory", lambda: 10**9)
-    hr.migrate(h, ZS)
+    migrate64(h, ZS)
     assert work and work[-1] == 1

@@ -190,7 +190,7 @@ def test_migrate_is_the_operators_adjoint(kind):
     opts = {"frame": "ground"} if ground else {"upsample": 2}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        img = hr.migrate(h, zs, medium=medium, **opts)
+        img = hr.migrate(h, zs, medium=medium, dtype=np.complex128, **opts)
         A = hr.migration_operator(h, zs, medium=medium, compensate_loss=True, equalize=True,
                                   illumination=None, **opts)
     np.testing.assert_array_equal(A.H @ A.vector(h), img.data.ravel())

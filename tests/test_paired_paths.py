@@ -44,6 +44,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from conftest import migrate64
 from holoradar.data.hologram import Hologram
 from holoradar.physics.incident import (
     incident_on_plane,
@@ -182,12 +183,12 @@ def test_migration_per_layer_and_deepest_shortcut_match_airy(mode):
     holo = Hologram(h, x, x, F)
     zs = np.array([0.20, 0.31, 0.35, 0.399, Z1, 0.45, 0.58])
     ref = np.array([np.conj(_airy(K, p * p + q * q, z, up=True)) for z in zs])
-    img = hr.migrate(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
+    img = migrate64(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
                      algorithm="frequency")
     np.testing.assert_allclose(img.data / h, np.broadcast_to(ref[:, None, None], img.data.shape),
                                rtol=ROUND, atol=0)
     for z, r in zip(zs[[1, 5]], ref[[1, 5]], strict=True):
-        one = hr.migrate(holo, float(z), medium=STACK_A, pad=False, compensate_loss=False)
+        one = migrate64(holo, float(z), medium=STACK_A, pad=False, compensate_loss=False)
         np.testing.assert_allclose(one.data / h, r, rtol=ROUND, atol=0)
 
 
@@ -201,7 +202,7 @@ def test_kspace_phase_step_matches_airy(mode):
     holo = Hologram(h, x, x, F)
     zs = Z1 + 0.02 + 0.02 * np.arange(10)
     ref = np.array([np.conj(_airy(K, p * p + q * q, z, up=True)) for z in zs])
-    img = hr.migrate(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
+    img = migrate64(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
                      algorithm="kspace")
     np.testing.assert_allclose(img.data / h, np.broadcast_to(ref[:, None, None], img.data.shape),
                                rtol=ROUND, atol=0)
@@ -225,7 +226,7 @@ def test_loss_compensation_is_the_closed_form_gain(mode):
     for z in (0.35, 0.5):
         a, a0 = absorbed(kap2, z), absorbed(0.0, z)
         gain = (1 / a0) * (1 + e) / (a / a0 + e)
-        img = hr.migrate(holo, z, medium=STACK_A, pad=False, compensate_loss=True, snr_db=40)
+        img = migrate64(holo, z, medium=STACK_A, pad=False, compensate_loss=True, snr_db=40)
         want = np.conj(_airy(K, kap2, z, up=True)) * gain
         np.testing.assert_allclose(img.data / h, want, rtol=1e-9, atol=0)
 
@@ -246,7 +247,7 @@ def test_transceiver_round_trip_matches_airy(algorithm):
     ref = np.array([np.conj(_airy(K, k4, z, up=True) * _airy(K, k4, z, up=False)) for z in zs])
     with warnings.catch_warnings():  # 1 cm > lambda/4: the mode is on the grid all the same
         warnings.simplefilter("ignore", hr.AliasingWarning)
-        img = hr.migrate(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
+        img = migrate64(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
                          algorithm=algorithm)
     np.testing.assert_allclose(img.data / h, np.broadcast_to(ref[:, None, None], img.data.shape),
                                rtol=ROUND, atol=0)
@@ -264,7 +265,7 @@ def test_migration_through_two_layers_matches_linear_solve(mode):
     for zs, algorithm in ((np.array([0.32, 0.35, 0.37, 0.40, 0.43, 0.5]), "frequency"),
                           (0.42 + 0.025 * np.arange(5), "kspace")):
         ref = np.array([np.conj(_solve_stack(K, ZB, EB, kap2, z, up=True)) for z in zs])
-        img = hr.migrate(holo, zs, medium=STACK_B, pad=False, compensate_loss=False,
+        img = migrate64(holo, zs, medium=STACK_B, pad=False, compensate_loss=False,
                          algorithm=algorithm)
         np.testing.assert_allclose(img.data / h,
                                    np.broadcast_to(ref[:, None, None], img.data.shape),
@@ -293,7 +294,7 @@ def test_wideband_sum_with_incident_phase_matches_airy(algorithm):
         for j, z in enumerate(zs):
             e0 = _airy(k, 0.0, z, up=False)
             ref[j] += np.conj(_airy(k, p * p + q * q, z, up=True)) * np.conj(e0) / abs(e0)
-    img = hr.migrate(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
+    img = migrate64(holo, zs, medium=STACK_A, pad=False, compensate_loss=False,
                      algorithm=algorithm)
     np.testing.assert_allclose(img.data / h, np.broadcast_to(ref[:, None, None], img.data.shape),
                                rtol=ROUND, atol=0)
@@ -340,13 +341,13 @@ def test_point_target_focuses_at_its_true_range(point_holograms, target, algorit
     n_reg = 2.0 if target < 0.45 else 2.5
     holo = point_holograms[target]
     zs = target + np.arange(-0.015, 0.01501, 0.001)
-    img = hr.migrate(holo, zs, medium=LOSSLESS, algorithm=algorithm)
+    img = migrate64(holo, zs, medium=LOSSLESS, algorithm=algorithm)
     a = np.abs(img.data)
     iz, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
     lam = hr.C0 / 10e9
     assert abs(zs[iz] - target) <= lam / (4 * n_reg) + 0.0005
     assert abs(img.x[ix]) < 1e-9 and abs(img.y[iy]) < 1e-9
-    incoherent = hr.migrate(holo, float(zs[iz]), medium=LOSSLESS, combine="incoherent")
+    incoherent = migrate64(holo, float(zs[iz]), medium=LOSSLESS, combine="incoherent")
     assert a[iz, iy, ix] >= 0.95 * np.sqrt(holo.nf) * incoherent.data[iy, ix]
 
 
@@ -529,8 +530,9 @@ def test_synthesis_removes_the_closed_form_incident_phase():
     waves = [hr.PlaneWave(np.radians(20), 0.0), hr.PlaneWave(np.radians(-15), np.radians(8))]
     zs = np.array([0.35, 0.47])
     views = [Hologram(h, x, y, F, source=s) for s in waves]
-    _, aligned = hr.synthesize(views, zs, medium=med, return_views=True)
-    plain = hr.migrate(Hologram(h, x, y, F), zs, medium=med).data
+    _, aligned = hr.synthesize(views, zs, medium=med, return_views=True,
+                                  dtype=np.complex128)
+    plain = migrate64(Hologram(h, x, y, F), zs, medium=med).data
     ok = np.abs(plain) > 0.1 * np.abs(plain).max()
     for i, s in enumerate(waves):
         ref = np.stack([_plane_wave_reference(s, x, y, z, (E1.real, E2.real)) for z in zs])
@@ -538,8 +540,9 @@ def test_synthesis_removes_the_closed_form_incident_phase():
         np.testing.assert_allclose(ratio[ok], (ref.conj() / np.abs(ref))[ok], rtol=0, atol=1e-9)
     horn_views = [Hologram(h, x, y, F, source=HORN)] * 2
     zs = Z0 + np.array(DEPTHS)
-    _, aligned = hr.synthesize(horn_views, zs, medium=HS, return_views=True)
-    plain = hr.migrate(Hologram(h, x, y, F), zs, medium=HS).data
+    _, aligned = hr.synthesize(horn_views, zs, medium=HS, return_views=True,
+                                  dtype=np.complex128)
+    plain = migrate64(Hologram(h, x, y, F), zs, medium=HS).data
     for j, d in enumerate(DEPTHS):
         u = aligned[0, j] / plain[j]
         e_ref, tol = _on_axis(d)

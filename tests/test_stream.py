@@ -29,7 +29,8 @@ def test_without_suppression_equals_synthesize(views):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", hr.AliasingWarning)
         imager = hr.StreamImager(views, 0.42, SAND, suppress=False)
-        ref = hr.synthesize(views, 0.42, medium=SAND, upsample=4, fov="full")
+        ref = hr.synthesize(views, 0.42, medium=SAND, upsample=4, fov="full",
+                              dtype=np.complex128)
     out = imager(np.stack([v.data for v in views]))
     np.testing.assert_allclose(out.x, ref.x)
     np.testing.assert_allclose(out.y, ref.y)

@@ -24,7 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import holoradar as hr
-from conftest import FUZZED
+from conftest import FUZZED, migrate64
 from holoradar.survey import store as survey_store
 from holoradar.survey import worker as survey_worker
 
@@ -65,7 +65,7 @@ def _assert_exact(store: Path, paths: list[Path], holos: list, **kw) -> np.ndarr
     by_path = {str(p.resolve()): h for p, h in zip(paths, holos, strict=True)}
     for i in np.nonzero(idx["done"])[0]:
         h = by_path[idx["frame_path"][i]]
-        ref = hr.migrate(h, Z, **kw).data
+        ref = migrate64(h, Z, **kw).data
         assert np.array_equal(s["images"][i], ref), f"frame {idx['frame_name'][i]} differs"
         assert idx["frame_x"][i] == h.pose.center[0] and idx["frame_y"][i] == h.pose.center[1]
     return idx["done"]
@@ -104,7 +104,7 @@ def test_bad_frames_are_reported_and_skipped(survey_frames, tmp_path: Path) -> N
     empty = tmp_path / "empty.nc"
     empty.write_bytes(b"")
     other = _frames(tmp_path / "big", 1, size=10)[0][0]  # another grid
-    image = hr.save(hr.migrate(holos[5], Z), tmp_path / "image.nc")
+    image = hr.save(migrate64(holos[5], Z), tmp_path / "image.nc")
     frames = [good[0], truncated, good[1], empty, good[2], other, image, good[3]]
     s = hr.survey.run_batch(frames, tmp_path / "s.zarr", z=Z, scheduler="synchronous")
     reasons = {Path(k["name"]).name: k["reason"] for k in s["skipped"]}
@@ -302,7 +302,7 @@ def test_images_are_compressed_and_plain_stores_still_work(survey_frames, tmp_pa
     assert _assert_exact(old, paths, holos).all()
     assert hr.survey.describe_store(old)["compressors"] == []
     np.testing.assert_array_equal(hr.survey.frame_image(old, 4).data,
-                                  hr.migrate(holos[4], Z).data)
+                                  migrate64(holos[4], Z).data)
 
     # A store of the version that shuffled bytes keeps its codec when resumed.
     from zarr.codecs import BloscCodec
@@ -396,7 +396,7 @@ def test_mosaic_places_a_point_target(tmp_path: Path) -> None:
     # goes through its pixels, so no interpolation); relative rounding ~1e-16.
     one = tmp_path / "one.zarr"
     hr.survey.run_batch(paths[4:5], one, z=[0.30], scheduler="synchronous")
-    ref = np.abs(hr.migrate(hr.load(paths[4]), [0.30]).data[0])
+    ref = np.abs(migrate64(hr.load(paths[4]), [0.30]).data[0])
     np.testing.assert_allclose(hr.survey.mosaic(one, 0.3).data, ref, rtol=1e-14, atol=0)
     img = hr.survey.frame_image(one, "t11.nc")
     assert np.allclose(img.x, (np.arange(16) - 7.5) * PITCH)

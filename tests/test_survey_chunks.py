@@ -18,6 +18,7 @@ import pytest
 from click.testing import CliRunner
 
 import holoradar as hr
+from conftest import migrate64
 from holoradar.app.cli import main
 from holoradar.io import readers
 from holoradar.survey import batch as survey_batch
@@ -55,7 +56,7 @@ def _consistent(store: Path, paths: list[Path], holos: list) -> np.ndarray:
     by_path = {str(p.resolve()): h for p, h in zip(paths, holos, strict=True)}
     for i in np.nonzero(idx["done"])[0]:
         h = by_path[idx["frame_path"][i]]
-        assert np.array_equal(images[i], hr.migrate(h, Z).data), idx["frame_name"][i]
+        assert np.array_equal(images[i], migrate64(h, Z).data), idx["frame_name"][i]
         assert idx["frame_x"][i] == h.pose.center[0]
     return idx["done"]
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
+from conftest import migrate64
 from holoradar.analysis.metrics import main_lobe_width, peak_position
 
 FREQS = np.linspace(8e9, 12e9, 11)  # 4 GHz in 400 MHz steps: unambiguous 37 cm in air
@@ -32,7 +33,7 @@ def test_monostatic_point_is_found_in_3d_with_the_range_resolution(eps):
     h = hr.simulate(hr.Scene(medium, targets=[hr.PointTarget(target)]), ap, FREQS)
     assert h.monostatic and h.data.shape == (11, 40, 40)
     zs = np.linspace(0.21, 0.29, 81)
-    img = hr.migrate(h, zs, medium=None if eps == 1.0 else medium, upsample=2)
+    img = migrate64(h, zs, medium=None if eps == 1.0 else medium, upsample=2)
     x, y, z = peak_position(img)
     res = hr.theory.range_resolution(4e9, eps)
     lam_c = hr.C0 / 10e9
@@ -49,30 +50,30 @@ def test_a_single_frequency_has_no_range_resolution():
     ap = hr.Aperture.grid(40, 0.0062, monostatic=True)
     h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.25))]), ap, FREQS)
     zs = np.linspace(0.15, 0.35, 81)
-    wide = np.abs(hr.migrate(h, zs).data).max(axis=(1, 2))
-    mono = np.abs(hr.migrate(h.at_frequency(5), zs).data).max(axis=(1, 2))
+    wide = np.abs(migrate64(h, zs).data).max(axis=(1, 2))
+    mono = np.abs(migrate64(h.at_frequency(5), zs).data).max(axis=(1, 2))
     assert main_lobe_width(wide, zs) < 0.5 * main_lobe_width(mono, zs)
 
 
 def test_combine_options_and_equalisation():
     ap = hr.Aperture.grid(16, 0.0062, monostatic=True)
     h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.2))]), ap, FREQS)
-    kept = hr.migrate(h, [0.19, 0.2], combine="none")
+    kept = migrate64(h, [0.19, 0.2], combine="none")
     assert kept.data.shape == (11, 2, 16, 16)
-    coh = hr.migrate(h, [0.19, 0.2], equalize=False, algorithm="frequency")
-    raw = hr.migrate(h, [0.19, 0.2], combine="none", equalize=False).data
+    coh = migrate64(h, [0.19, 0.2], equalize=False, algorithm="frequency")
+    raw = migrate64(h, [0.19, 0.2], combine="none", equalize=False).data
     np.testing.assert_allclose(coh.data, raw.sum(axis=0), rtol=1e-12)
-    inc = hr.migrate(h, 0.2, combine="incoherent", equalize=False)
-    parts = hr.migrate(h, 0.2, combine="none", equalize=False).data
+    inc = migrate64(h, 0.2, combine="incoherent", equalize=False)
+    parts = migrate64(h, 0.2, combine="none", equalize=False).data
     np.testing.assert_allclose(inc.data, np.sqrt((np.abs(parts) ** 2).sum(axis=0)), rtol=1e-12)
     # equalize=True: each frequency's hologram scaled to unit RMS
-    eq = hr.migrate(h, 0.2, combine="none").data
+    eq = migrate64(h, 0.2, combine="none").data
     rms = np.sqrt(np.mean(np.abs(h.data) ** 2, axis=(1, 2)))
     np.testing.assert_allclose(eq, parts / rms[:, None, None], rtol=1e-12)
     with pytest.raises(ValueError, match="equalize must be"):
-        hr.migrate(h, 0.2, equalize=[1.0, 2.0])
+        migrate64(h, 0.2, equalize=[1.0, 2.0])
     with pytest.raises(ValueError, match="combine must be"):
-        hr.migrate(h, 0.2, combine="sum")
+        migrate64(h, 0.2, combine="sum")
 
 
 def test_array_geometry_frequencies_add_after_the_incident_phase():
@@ -85,11 +86,11 @@ def test_array_geometry_frequencies_add_after_the_incident_phase():
     h = hr.simulate(hr.Scene(targets=[hr.PointTarget(target)]), ap, FREQS)
     assert h.source is not None and not h.monostatic
     zs = np.linspace(0.21, 0.29, 81)
-    img = hr.migrate(h, zs, upsample=2)
+    img = migrate64(h, zs, upsample=2)
     assert abs(peak_position(img)[2] - target[2]) < hr.theory.range_resolution(
         4e9, monostatic=False) / 4
     with pytest.warns(hr.IlluminationWarning, match="plane wave at normal incidence"):
-        hr.migrate(h.replace(source=None), 0.25)
+        migrate64(h.replace(source=None), 0.25)
 
 
 def test_full_field_of_view_over_a_band_shares_one_grid():
@@ -103,8 +104,8 @@ def test_full_field_of_view_over_a_band_shares_one_grid():
     zs = np.linspace(0.46, 0.54, 81)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", hr.AliasingWarning)  # the pitch, on purpose
-        img = hr.migrate(h, zs, fov="full")
-        aperture = hr.migrate(h, zs)
+        img = migrate64(h, zs, fov="full")
+        aperture = migrate64(h, zs)
     assert img.data.shape[-1] > aperture.data.shape[-1]
     assert abs(peak_position(img)[2] - target[2]) < hr.theory.range_resolution(
         4e9, monostatic=False) / 4
@@ -128,7 +129,7 @@ def test_wideband_bad_input():
         warnings.simplefilter("error")
         # a transceiver at lambda/4 pitch is not aliased; at lambda/2 it is
         with pytest.raises(hr.AliasingWarning, match="lambda/4"):
-            hr.migrate(hr.Hologram(np.ones((8, 8)), x * 2.4, x * 2.4, 12e9, monostatic=True),
+            migrate64(hr.Hologram(np.ones((8, 8)), x * 2.4, x * 2.4, 12e9, monostatic=True),
                        0.2)
 
 
@@ -169,11 +170,11 @@ def test_wavenumber_domain_sum_equals_the_per_frequency_sum(geometry, medium):
                     include_surface=False)
     zs = np.linspace(0.16, 0.30, 29)
     med = None if medium.is_free_space else medium
-    a = hr.migrate(h, zs, medium=med, algorithm="kspace", pad=3.0, upsample=2)
-    b = hr.migrate(h, zs, medium=med, algorithm="frequency", pad=3.0, upsample=2)
+    a = migrate64(h, zs, medium=med, algorithm="kspace", pad=3.0, upsample=2)
+    b = migrate64(h, zs, medium=med, algorithm="frequency", pad=3.0, upsample=2)
     assert np.linalg.norm(a.data - b.data) < 1e-10 * np.linalg.norm(b.data)
     with pytest.raises(ValueError, match="algorithm='kspace' needs"):
-        hr.migrate(h, [0.2, 0.21, 0.23], medium=med, algorithm="kspace")
+        migrate64(h, [0.2, 0.21, 0.23], medium=med, algorithm="kspace")
 
 
 def test_monostatic_loss_compensation_keeps_the_range():
@@ -191,7 +192,7 @@ def test_monostatic_loss_compensation_keeps_the_range():
         h = hr.simulate(hr.Scene(medium, targets=[hr.PointTarget((0.0, 0.0, 0.25))]), ap, FREQS,
                         include_surface=False)
         for comp in (True, False):
-            img = hr.migrate(h, zs, medium=medium, compensate_loss=comp, equalize=False)
+            img = migrate64(h, zs, medium=medium, compensate_loss=comp, equalize=False)
             peaks[name, comp] = peak_position(img)[2]
     res = hr.theory.range_resolution(4e9, eps)
     assert abs(peaks["lossy", True] - peaks["lossless", True]) < res / 10
@@ -230,8 +231,8 @@ def test_one_frequency_phase_step_equals_plane_by_plane(monostatic, medium):
     h = hr.Hologram(rng.standard_normal((2, 24, 24)) + 1j * rng.standard_normal((2, 24, 24)),
                     x, x, 10e9, monostatic=monostatic)
     zs = np.linspace(0.15, 0.30, 16)
-    a = hr.migrate(h, zs, medium=medium, upsample=2, algorithm="kspace")
-    b = hr.migrate(h, zs, medium=medium, upsample=2, algorithm="frequency")
+    a = migrate64(h, zs, medium=medium, upsample=2, algorithm="kspace")
+    b = migrate64(h, zs, medium=medium, upsample=2, algorithm="frequency")
     assert a.data.shape == b.data.shape == (2, 16, 47, 47)
     assert np.linalg.norm(a.data - b.data) < 1e-10 * np.linalg.norm(b.data)
 

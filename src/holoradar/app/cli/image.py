@@ -65,6 +65,9 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
 @frame_option
 @click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32),
               help="Image pixels per element pitch.")
+@click.option("--double", is_flag=True,
+              help="Compute in double precision (default single: within 1e-6 of the image's "
+                   "peak, about twice as fast).")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
               help="Output image: .nc (NetCDF-4, holoradar.load reads it) or .npz.")
 @click.option("--png/--no-png", default=True, show_default=True,
@@ -73,8 +76,8 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
 @layout_option
 @output_options
 def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str, frame: str,
-          upsample: int, out: Path, png: bool, force: bool, layout: str | None, check: bool,
-          report: Reporter) -> None:
+          upsample: int, double: bool, out: Path, png: bool, force: bool, layout: str | None,
+          check: bool, report: Reporter) -> None:
     """Migrate a hologram to range(s) Z through air or a (layered, lossy) ground.
 
     HOLOGRAM_FILE: a holoradar .nc file, or a user's .npz, .npy (+ .json
@@ -101,7 +104,8 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
         check_planes(holo, zs, z, medium, medium_spec, check)
         t0 = time.perf_counter()
         img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
-                      progress=report.progress)
+                      progress=report.progress,
+                      dtype=np.complex128 if double else np.complex64)
         seconds = time.perf_counter() - t0
         pk = peak_position(img)
         # data in the other I/Q convention, a picture of the glare: said, with the fix
@@ -118,6 +122,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
     history = [*input_history(hologram_file, layout), {
         "step": "migrate", "input": hologram_file.name,
         "parameters": {"z": z, "method": method, "frame": frame, "upsample": upsample,
+                       "precision": "double" if double else "single",
                        "layout": layout, "medium": ground}, "warnings": texts}]
     files = write_image(img, out, force, history, png, f"{hologram_file.name} ({method})")
     report.done({"peak_m": pk, "out": str(out), "files": files, "planes": int(img.z.size),

@@ -44,6 +44,8 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ...imaging.migration.settings import MigrationSettings, check_choice, check_upsample
 
 __all__ = ["GLARE_METHODS", "MODES", "PLANES", "ViewSettings", "read_settings", "settings_toml"]
@@ -105,7 +107,7 @@ class ViewSettings:
             upsample=self.upsample, frame=self.frame,
             fov=self.fov if self.frame == "aperture" else "aperture",
             combine="incoherent" if self.frequency == "incoherent" else "coherent",
-            progress=False)
+            progress=False, dtype=np.complex64)   # migrate's default precision
 
     def replace(self, **changes: Any) -> ViewSettings:
         """A copy with ``changes`` (checked like the constructor's arguments)."""
