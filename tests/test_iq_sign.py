@@ -228,3 +228,16 @@ def test_an_undecided_check_says_why_and_iq_convention_warns_of_nothing_it_was_n
     with warnings.catch_warnings():
         warnings.simplefilter("error", hr.IlluminationWarning)
         hr.iq_convention(h, [0.2, 0.3])
+
+
+def test_image_command_takes_planes_from_the_aperture_itself(tmp_path):
+    """Planes from z = 0 (a scanned transceiver imaged from its own plane): the I/Q check
+    looks at the planes in front of the array only; the image is made."""
+    from cli_helpers import run
+
+    ap = hr.Aperture.grid(24, 0.0062, monostatic=True)
+    h = hr.simulate(hr.Scene(targets=[hr.PointTarget((0.01, 0.0, 0.1))]), ap, BAND)
+    src = hr.save(h, tmp_path / "h.nc")
+    run("image", src, "--z", "0:0.15:0.01", "--upsample", "1", "--no-png", "-o",
+        tmp_path / "i.nc")
+    assert hr.load(tmp_path / "i.nc").z[0] == 0.0

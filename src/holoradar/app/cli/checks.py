@@ -69,8 +69,13 @@ def check_image(path: Path, hologram: Any, image: Any, medium: Any, medium_spec:
     else:
         iq_fix = ("add iq_sign=I-iQ to the layout: --layout "
                   + shlex.quote(",".join(p for p in (layout, "iq_sign=I-iQ") if p)))
-    iq = warn_if_conjugated(hologram, z, what=path.name, fix=iq_fix, medium=medium,
-                            frame=frame, method=method, stacklevel=2)
+    # The check looks at ranges in front of the array: a plane at the aperture itself
+    # (z = 0) focuses nothing on either side and is left out of it.
+    ahead = np.atleast_1d(np.asarray(z, float))
+    ahead = ahead[ahead > 0]
+    iq = warn_if_conjugated(hologram, ahead if ahead.size else None, what=path.name,
+                            fix=iq_fix, medium=medium, frame=frame, method=method,
+                            stacklevel=2)
     out: dict[str, Any] = {"iq_sign": iq.sign, "glare_dominates": None}
     if iq.sign == "I-iQ":  # the glare fit of data in the other convention means nothing
         return out
