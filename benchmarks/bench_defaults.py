@@ -1,0 +1,124 @@
+"""``migrate`` as a user calls it: complex128 data, default options, warm and cold.
+
+The case is the size of a measured scanned-transceiver hologram: 11 frequencies
+8-12 GHz x 187 x 144 elements at 3 mm, imaged onto 110 planes 0-0.18 m. Timed in one
+run, ratios only (the machine is shared):
+
+* ``default``: ``hr.migrate(h, zs)`` on complex128 data (single precision, the default
+  padding);
+* ``double``: the same with ``dtype=np.complex128`` (the previous default);
+* ``unpadded``: the default with ``pad=False``;
+* ``floor``: what the work needs at least: one ``fft2`` per frequency and one inverse
+  FFT per plane, complex64, unpadded;
+* ``makers``: a device maker's 40-line NumPy Stolt (``bench_fft_limit.makers_stolt``);
+* ``cold``: the default's first call in a fresh process (``import holoradar`` and the
+  data made before the clock starts), and the whole of ``holoradar image`` on a file
+  in a fresh process (start, import, read, image, write).
+
+Writes ``benchmarks/results_defaults.json``. Run: ``python benchmarks/bench_defaults.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).parent
+NF, NY, NX, NZ, ZMAX = 11, 187, 144, 110, 0.18
+
+
+def hologram(dtype=np.complex128):
+    import holoradar as hr
+
+    rng = np.random.default_rng(0)
+    data = (rng.standard_normal((NF, NY, NX)) + 1j * rng.standard_normal((NF, NY, NX)))
+    return (hr.Hologram(data.astype(dtype), np.arange(NX) * 0.003, np.arange(NY) * 0.003,
+                        np.linspace(8e9, 12e9, NF), monostatic=True),
+            np.linspace(0.0, ZMAX, NZ))
+
+
+def best(fn, n: int = 3) -> float:
+    times = []
+    for _ in range(n):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def cold_child() -> None:
+    import holoradar as hr
+
+    h, zs = hologram()
+    t = time.perf_counter()
+    hr.migrate(h, zs)
+    print(time.perf_counter() - t)
+
+
+def main() -> None:
+    import scipy.fft as sfft
+
+    import holoradar as hr
+    sys.path.insert(0, str(HERE))
+    from bench_fft_limit import makers_stolt
+
+    h, zs = hologram()
+    h64, _ = hologram(np.complex64)
+    vol = np.zeros((NZ, NY, NX), np.complex64)
+
+    def floor() -> None:
+        sfft.fft2(h64.data, workers=-1)
+        sfft.ifft2(vol, workers=-1)
+
+    runs = {
+        "default": lambda: hr.migrate(h, zs),
+        "double": lambda: hr.migrate(h, zs, dtype=np.complex128),
+        "unpadded": lambda: hr.migrate(h, zs, pad=False),
+        "floor": floor,
+        "makers": lambda: makers_stolt(h, zs),
+    }
+    for fn in runs.values():
+        fn()   # warm: plans, caches, the compiled loop
+    warm = {k: best(fn) for k, fn in runs.items()}
+    cold = [float(subprocess.run([sys.executable, __file__, "--cold"], capture_output=True,
+                                 text=True, check=True).stdout.strip().splitlines()[-1])
+            for _ in range(3)]
+    with tempfile.TemporaryDirectory() as d:
+        src = Path(d) / "h.nc"
+        hr.save(h, src)
+        ends = []
+        for i in range(3):
+            t = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "holoradar", "image", str(src), "--z",
+                            f"0:{ZMAX}:{ZMAX / (NZ - 1)}", "--upsample", "1", "--no-png",
+                            "-q", "-o", str(Path(d) / f"i{i}.nc")], check=True)
+            ends.append(time.perf_counter() - t)
+    out = {
+        "case": f"{NF} frequencies x {NY} x {NX} at 3 mm onto {NZ} planes, complex128 data",
+        "warm_s": warm,
+        "cold_first_call_s": statistics.median(cold),
+        "cli_end_to_end_s": statistics.median(ends),
+        "ratios": {
+            "default_over_floor": warm["default"] / warm["floor"],
+            "makers_over_default": warm["makers"] / warm["default"],
+            "double_over_default": warm["double"] / warm["default"],
+            "default_over_unpadded": warm["default"] / warm["unpadded"],
+            "cold_over_floor": statistics.median(cold) / warm["floor"],
+        },
+    }
+    (HERE / "results_defaults.json").write_text(json.dumps(out, indent=2) + "\n")
+    print(json.dumps(out, indent=2))
+
+
+if __name__ == "__main__":
+    if "--cold" in sys.argv:
+        cold_child()
+    else:
+        main()
