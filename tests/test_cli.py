@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 
 import holoradar as hr
@@ -156,3 +157,33 @@ def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch, tmp
                     assert not box.overlaps(other.get_window_extent(renderer)), ax.get_title()
     glare = next(f.get_suptitle() for f in figs if "mirror image" in f.get_suptitle())
     assert "2 z0 - z_s" in glare and "surface z0 = 30 cm" in glare and "horn z_s = 0 cm" in glare
+
+
+def test_demo_spectrum_window_is_where_the_summary_says(monkeypatch, tmp_path):
+    """The horn at y = -0.25 m lights the letter from -y: its wave runs towards +y across
+    the array (q0 > 0, exp(i q0 y) under exp(-i omega t)). The recorded field is the
+    object times exp(i q0 y), whose spectrum is F(q - q0): the array's |q| <= nu records
+    the object's frequencies around -q0. The figure's rectangle is centred there, and
+    the summary says both numbers."""
+    from matplotlib.patches import Rectangle
+
+    from holoradar.app import demo, plotting
+
+    figs = []
+    real = plotting.to_png
+
+    def keep(fig, *args, **kwargs):
+        figs.append(fig)
+        return real(fig, *args, **kwargs)
+
+    monkeypatch.setattr(plotting, "to_png", keep)
+    s = demo.run_demo(tmp_path / "demo", upsample=1)
+    p0, q0 = s["theory"]["illumination_p0_q0_rad_per_m"]
+    assert q0 > 0 and abs(p0) < 1e-9
+    assert s["theory"]["window_center_in_object_spectrum_rad_per_m"] == [-p0, -q0]
+    fig = next(f for f in figs if "spectrum" in f.axes[0].get_title())
+    rect = next(a for a in fig.axes[0].patches if isinstance(a, Rectangle)
+                and a.get_label() == "spectral window")
+    cx = rect.get_x() + rect.get_width() / 2
+    cy = rect.get_y() + rect.get_height() / 2
+    assert (cx, cy) == pytest.approx((-p0, -q0), abs=1e-9)

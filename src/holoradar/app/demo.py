@@ -132,7 +132,13 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
             "max_unaliased_angle_deg": float(np.degrees(theory.max_unaliased_angle(
                 float(ap.x[1] - ap.x[0]), lam))),
             "window_mu_nu_rad_per_m": [win.mu, win.nu],
+            # The illumination's wavevector across the array (the horn at y = -0.25 m
+            # lights the object from -y: the wave runs towards +y, q0 > 0) and, where the
+            # figure draws it, the window in the object's spectrum: exp(i q0 y) shifts
+            # the object's spectrum to F(q - q0), so the array's |q| <= nu records the
+            # object's frequencies around -q0.
             "illumination_p0_q0_rad_per_m": [win.p0, win.q0],
+            "window_center_in_object_spectrum_rad_per_m": list(win.center),
         },
         "image_peak_m": {"with_surface_glare_through_sand": list(peak),
                          "targets_only": list(peak_clean)},
@@ -167,7 +173,9 @@ def run_demo(out: str | Path | None = "demo_out", *, upsample: int = 8,
         "spectrum_window.png": plotting.plot_spectrum(
             p[keep], p[keep], spec[np.ix_(keep, keep)], [win],
             nyquist=np.pi / float(ap.x[1] - ap.x[0]),
-            title="Letter R spectrum |F(p, q)|, 16 x 16 array's window"),
+            title="Letter R spectrum |F(p, q)|, the array's window\n"
+                  f"at (-p0, -q0) = ({win.center[0] + 0.0:.0f}, {win.center[1] + 0.0:.0f}); "
+                  f"horn's (p0, q0) = ({win.p0 + 0.0:.0f}, {win.q0 + 0.0:.0f}) rad/m"),
     }
     pngs = {name: plotting.to_png(fig) for name, fig in figs.items()}
     outdir = Path(out)
