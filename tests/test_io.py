@@ -265,7 +265,7 @@ def test_unreadable_files_get_one_clear_error(tmp_path):
     text.write_text("x,y\n1,2\n")
     with pytest.raises(ValueError, match="empty"):
         hr.load(empty)
-    with pytest.raises(ValueError, match="not a readable"):
+    with pytest.raises(ValueError, match="not a NetCDF file"):
         hr.load(text)
     with pytest.raises(ValueError, match="not a file"):
         hr.load(tmp_path / "nowhere.nc")
@@ -327,3 +327,18 @@ def test_fuzzed_files_fail_cleanly_and_stay_untouched(tmp_path, data):
     except ValueError:
         pass
     assert path.read_bytes() == before
+
+
+def test_a_text_file_named_nc_is_one_line_naming_it(tmp_path):
+    """A text file given as NetCDF: the file named, what it is and what holoradar reads,
+    not xarray's list of engines."""
+    from cli_helpers import one_line_error, run
+
+    p = tmp_path / "scan.nc"
+    p.write_text("x y re im\n0 0 1 0\n")
+    with pytest.raises(ValueError, match=r"scan\.nc is not a NetCDF file \(it is text\)") as e:
+        hr.load(p)
+    assert "engine" not in str(e.value)
+    res = run("info", p, ok=False)
+    one_line_error(res, "scan.nc is not a NetCDF file (it is text)")
+    assert "engine" not in res.output

@@ -159,15 +159,8 @@ def test_batch_messages_a_user_reported(survey: list[Path], tmp_path: Path,
     assert f"imaging 7 frames into {store}: up to {7 * per / 1e3:.0f} kB ({per / 1e3:.3g} kB " \
         "a frame before compression)" in res.stdout
     text = next(ln for ln in res.output.splitlines() if "h_text.nc" in ln)
-    reason = text.split("(ValueError: ", 1)[1]
-    assert reason.endswith(" ...)")  # xarray's long message, cut between two words
-    import xarray as xr
-
-    with pytest.raises(ValueError) as full:
-        xr.open_dataset(survey[-1])
-    words = " ".join(str(full.value).split()).split(" ")
-    kept = reason[: -len(" ...)")].split(" ")
-    assert kept == words[: len(kept)]
+    # a text file posing as NetCDF: said in words, not xarray's list of engines
+    assert "is not a NetCDF file (it is text)" in text and "engine" not in text
 
     res = run(*args)  # the two bad frames are tried again, and skipped again
     assert res.output.strip().splitlines()[-1] == \

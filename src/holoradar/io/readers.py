@@ -355,6 +355,30 @@ def _shorten(text: str, width: int) -> str:
     return cut.rstrip(" ,;:") + " ..."
 
 
+_NETCDF_MAGIC = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+
+
+def _file_signature(path: Path) -> str | None:
+    """Why ``path`` cannot be NetCDF by its first bytes (None: it may be): empty, text,
+    or another binary format. NetCDF-3 starts ``CDF``, NetCDF-4 with HDF5's signature
+    (at offset 0, or 512, 1024, ... after a user block)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4096)
+    except OSError:
+        return None
+    if not head:
+        return "the file is empty"
+    if any(head.startswith(m) for m in _NETCDF_MAGIC) or any(
+            head[o:o + 8] == _NETCDF_MAGIC[-1] for o in (512, 1024, 2048)):
+        return None
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError:
+        return "its first bytes are neither NetCDF-3 nor HDF5's"
+    return "it is text"
+
+
 def read_netcdf_variables(path: Path) -> dict[str, np.ndarray]:
     """A NetCDF file not written by holoradar (NetCDF-4 or NetCDF-3): every numeric
     variable by name, CF-decoded (``scale_factor``, ``add_offset``, ``_FillValue`` applied,
@@ -364,6 +388,12 @@ def read_netcdf_variables(path: Path) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {}
     other: list[str] = []
     total = 0
+    kind = _file_signature(path)
+    if kind is not None:
+        raise ValueError(f"{path.name} is not a NetCDF file ({kind}): holoradar reads "
+                         "NetCDF-4/HDF5 and NetCDF-3 .nc files; for a table or another "
+                         "format give its own suffix (.csv, .txt with --layout wide, .npz, "
+                         ".mat, .h5)")
     try:
         ds = xr.open_dataset(path, decode_times=False, decode_timedelta=False)
     except (ValueError, OSError, TypeError, KeyError) as exc:
