@@ -495,3 +495,30 @@ def test_info_shows_each_steps_parameters_and_refusals_name_force(holo_nc, tmp_p
     assert "overwrite=True" not in res.output
     with pytest.raises(ValueError, match=r"exists: pass overwrite=True to replace it"):
         hr.save(hr.load(holo_nc), holo_nc)  # the API keeps the API's word
+
+
+def test_image_says_a_large_output_and_refuses_what_the_disk_cannot_hold(holo_nc, tmp_path,
+                                                                        monkeypatch):
+    """The image's size is known before any work: planes x pixels x 8 bytes (I and Q as
+    float32). Over ANNOUNCE_BYTES it is said; over the disk's free room it is refused,
+    naming --out, and nothing is written."""
+    import shutil
+    from collections import namedtuple
+
+    from holoradar.app.cli import image as image_cmd
+
+    h = hr.load(holo_nc)
+    ny, nx = h.data.shape[-2:]
+    need = 3 * (2 * (ny - 1) + 1) * (2 * (nx - 1) + 1) * 8
+    monkeypatch.setattr(image_cmd, "ANNOUNCE_BYTES", need - 1)
+    res = run("image", holo_nc, "--z", "0.3:0.5:0.1", "--upsample", "2", "--no-png", "-o",
+              tmp_path / "a.nc")
+    from holoradar.survey.space import bytes_text
+
+    assert f"the image will take {bytes_text(need)} (3 planes of" in res.output
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(10**9, 10**9, need - 1))
+    res = run("image", holo_nc, "--z", "0.3:0.5:0.1", "--upsample", "2", "--no-png", "-o",
+              tmp_path / "b.nc", ok=False)
+    one_line_error(res, "--out", "free")
+    assert not (tmp_path / "b.nc").exists()

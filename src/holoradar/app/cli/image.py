@@ -102,6 +102,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
         holo = read_hologram(hologram_file, layout, check)
         medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
         check_planes(holo, zs, z, medium, medium_spec, check)
+        _check_room(holo, zs, upsample, double, out, report)
         t0 = time.perf_counter()
         img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,
                       progress=report.progress,
@@ -135,3 +136,32 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
 
 
 COMMANDS = [image]
+
+
+#: An output past this size is announced before any work (as a survey's batch does).
+ANNOUNCE_BYTES = 1e9
+
+
+def _check_room(holo: Any, zs: Any, upsample: int, double: bool, out: Path,
+                report: Reporter) -> None:
+    """The image file's size (planes x pixels x I and Q) before any work: said when it
+    passes :data:`ANNOUNCE_BYTES`, refused when the output's disk cannot hold it."""
+    import shutil
+
+    from ...survey.space import bytes_text
+
+    ny, nx = holo.data.shape[-2:]
+    frames = int(np.prod(holo.data.shape[:-3 if holo.is_wideband else -2]))
+    planes = int(np.size(zs))
+    pixels = (upsample * (ny - 1) + 1) * (upsample * (nx - 1) + 1)
+    need = frames * planes * pixels * (16 if double else 8)
+    free = shutil.disk_usage(out.resolve().parent).free
+    shape = f"{planes} planes of {upsample * (nx - 1) + 1} x {upsample * (ny - 1) + 1} pixels"
+    if need > free:
+        raise click.BadParameter(
+            f"the image would take {bytes_text(need)} ({shape}) but the disk of {out.name} "
+            f"has {bytes_text(free)} free: fewer planes (--z), a smaller --upsample, or "
+            "another disk", param_hint="--out")
+    if need > ANNOUNCE_BYTES:
+        report.line(f"the image will take {bytes_text(need)} ({shape}); "
+                    f"{bytes_text(free)} free on its disk")
