@@ -186,3 +186,21 @@ def test_reference_noise_of_an_image_smaller_than_the_guard_box():
     s2, n = candidate_noise(r, np.zeros((5, 5), bool), (0, 2, 2), np.arange(5.0) * 0.01,
                             np.arange(5.0) * 0.01, (0.05, 0.05, np.inf))
     assert s2 == 4.0 and n >= 1.0
+
+
+def test_an_eps_interval_that_excludes_the_images_eps_warns():
+    """Depths are read off a focus made at the ground's eps'; an interval that does not
+    hold it describes another focus: said (with the CLI's one warning line), and an
+    interval about it is quiet."""
+    import warnings
+
+    sand = hr.Medium.half_space(0.3, 2.5)
+    sc = hr.Scene(sand, hr.PlaneWave(), [hr.PointTarget((0.0, 0.0, 0.42))])
+    h = hr.simulate(sc, hr.Aperture.grid(24, 0.0125), 9.9e9, include_surface=False,
+                    snr_db=40, seed=0)
+    img = hr.migrate(h, 0.42, medium=sand, upsample=2)
+    with pytest.warns(hr.PermittivityIntervalWarning, match=r"\[5\.5, 6\.5\] excludes .*2\.5"):
+        hr.detect(img, medium=sand, eps_interval=(5.5, 6.5))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", hr.PermittivityIntervalWarning)
+        hr.detect(img, medium=sand, eps_interval=(2.2, 2.8))

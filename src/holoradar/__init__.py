@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     from ._validate import AliasingWarning
     from ._version import __version__
     from .analysis.detect import detect, rebar_layers, unbiased_peak
+    from .analysis.detect.api import PermittivityIntervalWarning
     from .analysis.oblique_plan import ObliquePlan, plan_oblique
     from .data.grid_axes import CoordinateWarning
     from .data.hologram import C0, Hologram, Image
@@ -61,6 +62,7 @@ _SUBMODULES = ("calibrate", "survey", "theory")
 _NAMES = {
     "__version__": "._version",
     "AliasingWarning": "._validate",
+    "PermittivityIntervalWarning": ".analysis.detect.api",
     "AngularSpectrum": ".physics.propagation",
     "Aperture": ".model.scene",
     "AutofocusResult": ".imaging.autofocus",
@@ -137,6 +139,7 @@ __all__ = [
     "Aperture",
     "AutofocusResult",
     "CoordinateWarning",
+    "PermittivityIntervalWarning",
     "Dipole",
     "FitWarning",
     "Fresnel",

@@ -38,6 +38,30 @@ def _check(false_alarm: Any, kinds: Any, medium: Any, eps_interval: Any) -> tupl
     return fa, ks
 
 
+class PermittivityIntervalWarning(UserWarning):
+    """An eps' interval that excludes the permittivity the image was focused with."""
+
+
+def _warn_if_outside(interval: tuple[float, float] | None, medium: Any) -> None:
+    """The depths are the image's, at the ground's own eps'; an interval that does not
+    hold it describes another focus: said, with the way out."""
+    if interval is None or medium is None or not medium.z_interfaces:
+        return
+    ground = [float(complex(e).real) for e in medium.eps[1:]]
+    lo, hi = interval
+    if all(not lo <= e <= hi for e in ground):
+        import warnings
+
+        from ..._validate import outside_stacklevel
+
+        shown = ", ".join(f"{e:.3g}" for e in ground)
+        warnings.warn(f"eps_interval [{lo:.3g}, {hi:.3g}] excludes the permittivity the image "
+                      f"was focused with ({shown}): the depths are that focus's, and their "
+                      "intervals stretch to the other eps'; image through a ground inside the "
+                      "interval (or give an interval about the image's eps')",
+                      PermittivityIntervalWarning, stacklevel=outside_stacklevel())
+
+
 def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
            false_alarm: float = 1e-3, kinds: Sequence[str] = _KINDS,
            hologram: Any = None, migrate_options: Mapping[str, Any] | None = None,
@@ -122,6 +146,7 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
     """
     fa, ks = _check(false_alarm, kinds, medium, eps_interval)
     interval = as_eps_interval(eps_interval)
+    _warn_if_outside(interval, medium)
     vol = as_volume(image)
     if isinstance(max_objects, bool) or not isinstance(max_objects, int | np.integer) \
             or max_objects < 1:
