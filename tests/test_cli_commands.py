@@ -522,3 +522,24 @@ def test_image_says_a_large_output_and_refuses_what_the_disk_cannot_hold(holo_nc
               tmp_path / "b.nc", ok=False)
     one_line_error(res, "--out", "free")
     assert not (tmp_path / "b.nc").exists()
+
+
+def test_suppress_says_eps_with_its_uncertainty_or_that_it_is_rough(tmp_path):
+    """The exact glare fit's eps with its 1-sigma and 95 % interval (digits from the
+    sigma, no rounding residue as eps''); the Gaussian fit's eps marked rough with the
+    way to an uncertainty; both in --json."""
+    run("demo", "--out", tmp_path / "d", "--upsample", "1", "--quiet")
+    h = tmp_path / "d" / "hologram.nc"
+    res = run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "--method", "image_source",
+              "--no-direct", "-o", tmp_path / "a.nc")
+    line = next(ln for ln in res.output.splitlines() if "permittivity" in ln)
+    assert "+-" in line and "(95 %: " in line and "e-" not in line, line
+    d = json.loads(run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "--method",
+                       "image_source", "--no-direct", "-o", tmp_path / "b.nc",
+                       "--json").stdout)
+    lo, hi = d["eps_interval_95"]
+    assert lo < d["eps"][0] < hi and d["eps_std"][0] > 0
+    assert lo < 2.5 < hi   # the demo's sand
+    res = run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "-o", tmp_path / "c.nc")
+    line = next(ln for ln in res.output.splitlines() if "permittivity" in ln)
+    assert "rough, no uncertainty" in line and "image_source" in line, line

@@ -118,12 +118,17 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
         "parameters": {"method": method, "direct": not no_direct, "layout": layout,
                        "background": None if background_file is None else
                        background_file.name}}])
+    from ..eps_text import eps_summary, eps_text
+
+    rough = ("" if rep.eps_std is not None else
+             f"from the {method} fit's glare strength; --method image_source fits the exact "
+             "glare with its uncertainty")
     s = {"out": str(out), "method": method, "glare_suppression_db": rep.glare_suppression_db,
-         "glare_removed_db": rep.glare_removed_db, "eps": rep.eps,
+         "glare_removed_db": rep.glare_removed_db, **eps_summary(rep.eps, rep.eps_std, rough),
          "mirror_position_m": rep.mirror_position, "converged": rep.converged,
          "seconds": seconds}
-    eps_line = [] if rep.eps is None else [f"ground permittivity from the glare: "
-                                           f"{rep.eps.real:.3g}{rep.eps.imag:+.2g}j"]
+    eps_line = [] if rep.eps is None else [
+        f"ground permittivity from the glare: {eps_text(rep.eps, rep.eps_std, rough=rough)}"]
     report.done(s, [
         f"glare suppressed by {rep.glare_suppression_db:.1f} dB at its mirror spot "
         f"({method}{'' if rep.converged else ', fit did not converge'}) in {seconds:.1f} s",
