@@ -266,3 +266,31 @@ def test_local_cluster_workers_run_one_thread_and_keep_freed_memory() -> None:
     assert all(e == {"HOLORADAR_THREADS": "1", "MALLOC_TRIM_THRESHOLD_": None}
                for e in seen.values()), seen
     assert dask.config.get("distributed.nanny.pre-spawn-environ") == before
+
+
+def test_chunk_writes_run_one_at_a_time_in_order(survey, tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """A worker's chunk writes never overlap and finish in the order submitted (two at
+    once let a later chunk finish first under load: the test above then failed now and
+    then). A slow write stands in for a loaded disk."""
+    import threading
+
+    paths, _ = survey
+    monkeypatch.setattr(survey_batch, "frames_per_chunk", lambda per, n: 4)
+    real = survey_worker.write_frames
+    running, order, overlaps = [0], [], []
+    lock = threading.Lock()
+
+    def slow(store, token, slots, block, positions):
+        with lock:
+            running[0] += 1
+            overlaps.append(running[0])
+        time.sleep(0.05)
+        real(store, token, slots, block, positions)
+        with lock:
+            running[0] -= 1
+            order.append(int(slots[0]))
+
+    monkeypatch.setattr(survey_worker, "write_frames", slow)
+    hr.survey.run_batch(paths, tmp_path / "s.zarr", z=Z, workers=1)
+    assert max(overlaps) == 1 and order == sorted(order) and len(order) == 3

@@ -10,7 +10,6 @@ thread of the worker's own while it images the next frames.
 
 from __future__ import annotations
 
-import threading
 import time
 import warnings
 from collections.abc import Sequence
@@ -110,12 +109,19 @@ class _Writer:
     worker images the next frames (compressing and writing files release the GIL).
 
     At most one write waits behind the one running, so at most two chunks of images
-    are held in memory. :meth:`drain` waits for all and raises a write's error.
+    are held in memory. The writes run in the order submitted, never two at once (a
+    single-thread executor): a chunk is complete before the next starts, whatever the
+    load (two writer threads at once let a later chunk finish first). :meth:`drain`
+    waits for all and raises a write's error.
     """
 
     def __init__(self, store: str, token: str) -> None:
+        from concurrent.futures import ThreadPoolExecutor
+
         self.store, self.token = store, token
         self.pending: list[Future[None]] = []
+        self.pool = ThreadPoolExecutor(max_workers=1,
+                                       thread_name_prefix="holoradar-survey-writer")
 
     def submit(self, slots: list[int], images: list[np.ndarray],
                positions: list[tuple[float, float, float]]) -> None:
@@ -125,22 +131,19 @@ class _Writer:
             self.pending.pop(0).result()
         real = np.float32 if images[0].dtype == np.complex64 else np.float64
         block = as_block(images, real)  # here: the worker's thread is the one with time
-        fut: Future[None] = Future()
-
-        def run() -> None:
-            try:
-                write_frames(self.store, self.token, slots, block, positions)
-            except BaseException as exc:  # handed to the task that waits on it
-                fut.set_exception(exc)
-            else:
-                fut.set_result(None)
-
-        threading.Thread(target=run, name="holoradar-survey-writer", daemon=True).start()
-        self.pending.append(fut)
+        self.pending.append(self.pool.submit(write_frames, self.store, self.token, slots,
+                                             block, positions))
 
     def drain(self) -> None:
         while self.pending:
             self.pending.pop(0).result()
+
+    def close(self) -> None:
+        """Drain, then end the writer's thread (it takes no more writes)."""
+        try:
+            self.drain()
+        finally:
+            self.pool.shutdown(wait=True)
 
 
 _WRITERS: dict[tuple[str, str], _Writer] = {}  # this process's writer of a run
@@ -164,7 +167,7 @@ def drain_writes() -> int:
     n = 0
     while _WRITERS:
         _, w = _WRITERS.popitem()
-        w.drain()
+        w.close()
         n += 1
     return n
 
