@@ -59,3 +59,22 @@ def test_every_documented_command_runs(page, tmp_path, monkeypatch):
         assert res.exit_code == 0, f"holoradar {' '.join(args)}\n{res.output}"
     left = [f for _, _, files in os.walk(tmp_path) for f in files if f.endswith(".tmp")]
     assert not left  # no temporary file left behind anywhere (the examples link not followed)
+
+
+@pytest.mark.slow
+def test_all_pages_run_in_order_in_one_folder(tmp_path, monkeypatch):
+    """A new user follows the README, then every page in turn, in one folder: no page's
+    command meets a file an earlier page left (an output refused as existing) or needs
+    one another page made. (Each page on its own: the test above.)"""
+    (tmp_path / "examples").symlink_to(REPO / "examples")
+    monkeypatch.chdir(tmp_path)
+    for page in PAGES:
+        for args in commands(page):
+            if args[0] == "python":
+                done = subprocess.run([sys.executable, *args[1:]], capture_output=True,
+                                      text=True, timeout=120)
+                assert done.returncode == 0, f"{page.name}: {' '.join(args)}\n{done.stderr}"
+                continue
+            res = CliRunner().invoke(main, [*args, "--quiet"] if args[0] != "demo" else
+                                     [*args, "--upsample", "2", "--quiet"])
+            assert res.exit_code == 0, f"{page.name}: holoradar {' '.join(args)}\n{res.output}"

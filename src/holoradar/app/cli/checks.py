@@ -85,8 +85,20 @@ def check_image(path: Path, hologram: Any, image: Any, medium: Any, medium_spec:
     out["glare_dominates"] = found.dominates
     if found.dominates:
         flags = ground_flags(medium_spec)
+        clean = shlex.quote(str(_fresh(path)))
         fix = (f"remove it first: holoradar suppress {shlex.quote(str(path))} {flags} "
-               f"--method image_source{'' if found.direct else ' --no-direct'} -o clean.nc, "
-               "then image clean.nc")
+               f"--method image_source{'' if found.direct else ' --no-direct'} -o {clean}, "
+               f"then image {clean}")
         warnings.warn(dominance_message(found, path.name, fix), GlareWarning, stacklevel=2)
+    return out
+
+
+def _fresh(path: Path) -> Path:
+    """A name beside ``path`` for its glare-free copy that no file has yet
+    (``scan_noglare.nc``, ``scan_noglare_2.nc``, ...): the suggested command must run."""
+    base = path.with_name(f"{path.stem}_noglare.nc")
+    out, i = base, 2
+    while out.exists():
+        out = base.with_name(f"{base.stem}_{i}.nc")
+        i += 1
     return out
