@@ -559,3 +559,26 @@ def test_reflectivity_display_is_invert_of_the_view(scene, tmp_path):
     toml = tmp_path / "look.toml"
     toml.write_text(settings_toml(s, relative_to=tmp_path))
     assert read_settings(toml).plane == "reflectivity"
+
+
+def test_ctrl_c_stops_the_viewer_with_one_line_and_exit_130(tmp_path, monkeypatch):
+    """Ctrl-C while the viewer serves: one line, exit code 130, as every command."""
+    from types import SimpleNamespace
+
+    from cli_helpers import run
+    from holoradar.app.cli import view as view_cmd
+
+    class Loop:
+        def start(self):
+            raise KeyboardInterrupt
+
+    stopped = []
+    monkeypatch.setattr(view_cmd, "_serve", lambda *a, **k: SimpleNamespace(
+        io_loop=Loop(), stop=lambda: stopped.append(True)))
+    monkeypatch.setattr("holoradar.app.view.server.url_of", lambda server, host: "http://x")
+    h = hr.save(hr.simulate(hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))]),
+                            hr.Aperture.grid(16, 0.01), 9.9e9), tmp_path / "h.nc")
+    res = run("view", h, "--no-browser", ok=False)
+    assert res.exit_code == 130, res.output
+    assert res.output.strip().splitlines()[-1].startswith("interrupted: the viewer stopped")
+    assert stopped == [True]

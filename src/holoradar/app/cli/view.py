@@ -165,7 +165,9 @@ def view(files: tuple[Path, ...], medium_spec: dict[str, Any], settings_file: Pa
     try:
         server.io_loop.start()
     except KeyboardInterrupt:
-        pass
+        # One line and exit code 130, as every command after Ctrl-C.
+        raise KeyboardInterrupt("the viewer stopped (it writes only what you exported)") \
+            from None
     finally:
         server.stop()
 

@@ -227,11 +227,13 @@ class ViewSession:
 
         Raw holograms over ground are mostly the surface glare (the horn's
         reflection): its speckle fills the planes near the surface and its focus
-        is the brightest point of the sweep. So, for holograms, the glare is
-        removed (the Gaussian-beam fit, the fast one) when it can be: the look
-        has a ground, every view's radiator is known and point-like (a horn, a
-        dipole, a Gaussian beam) and every fit succeeds; and the depth is that of
-        the brightest point of the sweep so imaged.
+        is the brightest point of the sweep. So, for holograms whose sweep's
+        brightest point is the glare (the dominance check of ``holoradar image``),
+        the glare is removed (the Gaussian-beam fit, the fast one) when it can be:
+        the look has a ground, every view's radiator is known and point-like (a
+        horn, a dipole, a Gaussian beam) and every fit succeeds. Data without glare
+        (removed before, or an object brighter than it) open as they are. The
+        depth is that of the brightest point of the sweep so imaged.
 
         Parameters
         ----------
@@ -254,17 +256,21 @@ class ViewSession:
         >>> d = pathlib.Path(tempfile.mkdtemp())
         >>> sand = hr.Medium.half_space(0.3, 2.5)
         >>> scene = hr.Scene(sand, hr.PointSource((0.0, -0.2, -0.05)),
-        ...                  [hr.PointTarget((0.0, 0.0, 0.4), 0.05)])
-        >>> p = hr.save(hr.simulate(scene, hr.Aperture.grid(16, 0.025), 9.9e9), d / "h.nc")
+        ...                  [hr.PointTarget((0.0, 0.0, 0.4), 0.01)])
+        >>> ap, ground = hr.Aperture.grid(16, 0.025), {"surface": 0.3, "eps": 2.5}
+        >>> p = hr.save(hr.simulate(scene, ap, 9.9e9), d / "h.nc")
         >>> session = ViewSession([p])
-        >>> look = session.opening_settings(session.default_settings({"surface": 0.3,
-        ...                                                          "eps": 2.5}))
+        >>> look = session.opening_settings(session.default_settings(ground))
         >>> look.glare, bool(0.0 < look.depth < 0.2)   # the object 10 cm deep, not the surface
         ('gaussian', True)
+        >>> q = hr.save(hr.simulate(scene, ap, 9.9e9, include_surface=False), d / "q.nc")
+        >>> session = ViewSession([q])   # no glare in the data: nothing to remove
+        >>> session.opening_settings(session.default_settings(ground)).glare
+        'off'
         """
         if self.kind != "holograms":
             return s
-        if glare and s.glare == "off" and self._glare_removable(s):
+        if glare and s.glare == "off" and self._glare_removable(s) and self._glare_shows(s):
             on = s.replace(glare="gaussian")
             _, notes = self.cleaned(on)
             if all(n.error is None for n in notes):
@@ -274,6 +280,29 @@ class ViewSession:
 
             s = s.replace(depth=float(peak_position(self.sweep(s))[2] - self.surface(s)))
         return s
+
+    def _glare_shows(self, s: ViewSettings) -> bool:
+        """Whether the raw sweep's brightest point is the surface glare (the dominance
+        check of ``holoradar image``) in the first view at its centre frequency; where
+        that cannot be told, True (the glare is the rule over ground). Data without glare
+        (removed before, or none) open as they are."""
+        from ...imaging.glare.dominance import glare_share
+        from ...imaging.migrate import migrate
+
+        h = self.views[0]
+        if h.is_wideband:
+            h = h.at_frequency(h.nf // 2)
+        a, b = s.sweep if s.sweep is not None else (0.0, 0.25)
+        zs = self.surface(s) + np.linspace(a, b, s.planes)
+        opts = {"upsample": s.upsample, "fov": s.fov if s.frame == "aperture" else "aperture"}
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                img = migrate(h, zs, medium=self.medium(s), **opts)
+                found = glare_share(h, img, self.medium(s), **opts)
+        except ValueError:
+            return True
+        return True if found is None else bool(found.dominates)
 
     def _glare_removable(self, s: ViewSettings) -> bool:
         """Whether ``s`` has a ground and every view a known point-like radiator."""
