@@ -218,3 +218,23 @@ def test_default_padding_holds_at_long_range(pitch_over_lambda):
         img = migrate64(h, 2.0).data
         ref = migrate64(h, 2.0, pad=16.0).data
     assert np.linalg.norm(img - ref) / np.linalg.norm(ref) < 0.02
+
+
+def test_unasked_progress_bar_only_on_a_terminal(monkeypatch):
+    """progress=None: a bar for long work (over 2e8 output pixels) on a terminal only; in
+    a pipe or a log file none (a bar's redraws are noise there)."""
+    import sys
+    from types import SimpleNamespace
+
+    from holoradar.imaging.migration.planes import _Progress
+
+    plan = SimpleNamespace(settings=SimpleNamespace(progress=None, upsample=1),
+                           z=np.zeros(1000), grid=(512, 512))
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    assert _Progress(plan, 1).bar is None
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    p = _Progress(plan, 1)
+    assert p.bar is not None
+    p.close()
+    plan.settings.progress = False
+    assert _Progress(plan, 1).bar is None

@@ -96,7 +96,7 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         for double.
     progress : bool, optional
         Show a progress bar once the work has taken a second; default: only when
-        the output exceeds 2e8 pixels.
+        the output exceeds 2e8 pixels and standard error is a terminal.
     combine : {"coherent", "incoherent", "none"}
         Several frequencies: ``"coherent"`` (default) sums the complex images of
         all frequencies, which focuses in depth (range resolution

@@ -372,7 +372,12 @@ class _Progress:
         self.bar: Any = None
         if s.progress is False:
             return
-        if s.progress or total * plan.grid[0] * plan.grid[1] * s.upsample ** 2 > 2e8:
+        import sys
+
+        # Unasked (None): a bar for long work on a terminal only (a bar redraws its
+        # line: in a pipe or a log it is hundreds of lines of noise).
+        big = total * plan.grid[0] * plan.grid[1] * s.upsample ** 2 > 2e8
+        if s.progress or (big and sys.stderr.isatty()):
             from tqdm.auto import tqdm  # here, not at import: holoradar._lazy
 
             # delay: a bar only for work that lasts (progress=True shows it after 1 s)
