@@ -33,8 +33,9 @@ shift the estimate by at most ``sqrt(E_err)/||D||``.
 Modules: :mod:`.api` (:func:`autofocus`, its steps), :mod:`.checks` (its
 arguments), :mod:`.search` (the best fit at each trial eps'),
 :mod:`.fit_statistics` (noise, detection and the sandwich factor at a fit),
-:mod:`.interval` (the profile-likelihood interval), :mod:`.glare_estimate` (the
-glare's own estimate and its combination with the focus's) and :mod:`.result`
+:mod:`.interval` (the profile-likelihood interval), :mod:`.crb` (the Cramér-Rao
+bound of eps' at the estimate, and why an interval exceeds it), :mod:`.glare_estimate`
+(the glare's own estimate and its combination with the focus's) and :mod:`.result`
 (:class:`AutofocusResult`).
 """
 

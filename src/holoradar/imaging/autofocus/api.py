@@ -103,8 +103,10 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         (``result.line_azimuth_deg``, ``result.line_length``), modelled as the
         simulation's :class:`~holoradar.LineTarget`. Lines need the vector model
         (a hologram with a ``polarization`` and a polarised source) on an untilted
-        grid, and are slow (every trial line costs nodes x elements x frequencies
-        interpolations).
+        grid. The search runs on the line's asymptotic (ray) field on part of the
+        data, the exact finite line corrects it once on all of it (seconds: 8-10 s
+        on a 41 x 41 x 21 hologram); further lines are fitted with the first while
+        each explains 2 % of the data (a rebar mat).
     line_radius : float
         The cylinder's radius in metres for ``target="line"`` (default 0.006, a 12 mm
         bar; a perfect conductor). A thick bar echoes from its near side: a wrong

@@ -109,7 +109,10 @@ def check_target(target: Any) -> None:
 
 def check_line_radius(line_radius: Any) -> float:
     """A line's radius in metres, > 0."""
-    r = float(line_radius) if np.isscalar(line_radius) else np.nan
+    try:
+        r = float(line_radius) if np.isscalar(line_radius) else np.nan
+    except (TypeError, ValueError):
+        r = np.nan
     if not (np.isfinite(r) and r > 0):
         raise ValueError(f"line_radius must be the bar's radius in metres (> 0), got "
                          f"{line_radius!r}")

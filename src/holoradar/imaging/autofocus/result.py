@@ -46,6 +46,15 @@ class AutofocusResult:
         ``detection_threshold`` the level noise alone exceeds with 1e-3 chance.
     noise_inflation : float
         The sandwich factor phi (1 for white residuals).
+    eps_crb : float or None
+        The Cramér-Rao bound's standard deviation of eps' at the focus's estimate: the
+        fitted model's Fisher information (eps', position, range and amplitude all
+        unknown) with the noise the fit leaves (:mod:`.crb`). ``None`` when the focus
+        gives no estimate (also when eps' is the glare's alone).
+    crb_note : str
+        Why the focus's interval is more than 1.5 times the bound's width
+        (``2 q eps_crb``): lack of fit, and the parameters eps' trades with most;
+        ``""`` when it is not.
     handle : str
         What fixes eps': the wave front's shape (one frequency) or the delays too.
     eps_grid, profile : ndarray
@@ -99,6 +108,8 @@ class AutofocusResult:
     medium: Medium | None = field(default=None, repr=False)
     line_azimuth_deg: float | None = None
     line_length: float | None = None
+    eps_crb: float | None = None
+    crb_note: str = ""
 
     @property
     def std(self) -> float | None:

@@ -78,6 +78,9 @@ class Search:
         self.alias = C0 / (2 * float(np.min(np.diff(f)))) if self.wideband else np.inf
         self.z0 = 0.0
         self.trials = 1
+        self.scan_length = True   # a line's first fit scans its length (_length_scan)
+        self.ftol = _FTOL         # the position fit's stopping rule ...
+        self.max_nfev: int | None = None  # ... and its most steps (None: scipy's)
 
     def locate(self, depth_range: tuple[float, float] | None, position: Any,
                z0: float) -> bool | None:
@@ -97,12 +100,7 @@ class Search:
                              f"max, got {depth_range!r}")
         zs = z0 + np.arange(max(d0, 1e-4), d1 + lam_m / 2, lam_m / 2)
         self.trials = zs.size * h.data.shape[-1] * h.data.shape[-2]
-        combine = "coherent" if self.pr.coherent else "incoherent"
-        with warnings.catch_warnings():  # only the brightest voxel is wanted here
-            warnings.simplefilter("ignore", AliasingWarning)
-            # A moved or tilted aperture: image on the ground's own (world) planes.
-            frame = "aperture" if h.pose.is_identity else "ground"
-            img = migrate(h, zs, medium=m, combine=combine, progress=False, frame=frame)
+        img = self._image(zs, m)
         a = np.abs(img.data)
         if position is not None:
             try:
@@ -135,6 +133,16 @@ class Search:
         if zp <= z0 + lam_m / 4 or z_a <= z0 + lam_m / 4:
             return None
         return True
+
+    def _image(self, zs: np.ndarray, medium: Medium) -> Any:
+        """The migrated image :meth:`locate` takes the object's column from."""
+        h = self.hologram
+        combine = "coherent" if self.pr.coherent else "incoherent"
+        with warnings.catch_warnings():  # only the brightest voxel is wanted here
+            warnings.simplefilter("ignore", AliasingWarning)
+            # A moved or tilted aperture: image on the ground's own (world) planes.
+            frame = "aperture" if h.pose.is_identity else "ground"
+            return migrate(h, zs, medium=medium, combine=combine, progress=False, frame=frame)
 
     def candidates(self) -> list[float]:
         """eps' where curvature and delay agree (half-space, paraxial), for every alias
@@ -196,6 +204,8 @@ class Search:
             # at the optimum), held during the sweep.
             return self._evaluate_fixed_shape(eps, floor, xy0, z_start, lam_m)
         p0 = np.array([xy0[0], xy0[1], z_start, *shape0])
+        if shape0.size and self.scan_length:
+            p0 = self._length_scan(eps, p0, lam_m)
 
         def resid(p: np.ndarray) -> np.ndarray:
             r, _, _ = pr.residual(eps, max(p[2], floor), np.r_[p[:2], p[3:]])
@@ -209,12 +219,35 @@ class Search:
             hi_b = np.r_[hi_b, shape0[0] + 0.35, max(min(pr.max_length, 2 * L0), lam_m * 1.01)]
             p0[3:] = np.clip(p0[3:], lo_b[3:] + 1e-9, hi_b[3:] - 1e-9)
             scale = np.r_[scale, 0.02, self.lam / 10]
-        p = _least_squares(resid, p0, lo_b, hi_b, scale)
+        p = _least_squares(resid, p0, lo_b, hi_b, scale, self.ftol, self.max_nfev)
         z = max(float(p[2]), floor)
         xy = np.r_[np.clip(p[:2], *pr.bounds), p[3:]]
         F = pr.focus(eps, z, xy)
         self.best[eps] = (F, z, xy)
         return self.best[eps]
+
+    def _length_scan(self, eps: float, p: np.ndarray, lam_m: float) -> np.ndarray:
+        """A line's ends with the best focus, one end then the other, every half
+        wavelength in the ground within half the longest line of its centre: the focus
+        ripples with each end's position (its diffraction interferes with the specular
+        echo, a period of a wavelength in the air or more, two to five of these steps),
+        so a local fit alone stops on the ripple nearest its start. Returns ``p`` with
+        the centre and length moved."""
+        x, y, z, phi, length = (float(v) for v in p)
+        t = np.array([np.cos(phi), np.sin(phi)])
+        ends = [-0.5 * length, 0.5 * length]
+        reach = 0.5 * self.pr.max_length
+        for j in (1, 0):
+            other = ends[1 - j]
+            grid = (np.arange(other + lam_m, reach + lam_m / 4, lam_m / 2) if j else
+                    np.arange(-reach, other - lam_m + lam_m / 4, lam_m / 2))
+            if grid.size == 0:
+                continue
+            F = [self.pr.focus(eps, z, np.r_[np.array([x, y]) + 0.5 * (e + other) * t, phi,
+                                            abs(e - other)]) for e in grid]
+            ends[j] = float(grid[int(np.argmax(F))])
+        c = np.array([x, y]) + 0.5 * (ends[0] + ends[1]) * t
+        return np.array([c[0], c[1], z, phi, ends[1] - ends[0]])
 
     def _start(self, eps: float, floor: float, lam_m: float) -> tuple[np.ndarray, float]:
         """The fit's start at ``eps``: the lateral position (and a line's shape) of the
@@ -275,7 +308,8 @@ class Search:
             return np.concatenate([r.real.ravel(), r.imag.ravel()])
 
         lo_b, hi_b = self._box(p0, eps, floor, lam_m)
-        p = _least_squares(resid, p0, lo_b, hi_b, np.full(3, self.lam / 10))
+        p = _least_squares(resid, p0, lo_b, hi_b, np.full(3, self.lam / 10), self.ftol,
+                           self.max_nfev)
         z = max(float(p[2]), floor)
         xy = np.r_[np.clip(p[:2], *pr.bounds), shape]
         self.best[eps] = (pr.focus(eps, z, xy), z, xy)
@@ -283,33 +317,47 @@ class Search:
 
 
 def _least_squares(resid: Callable[[np.ndarray], np.ndarray], p0: np.ndarray,
-                   lo_b: np.ndarray, hi_b: np.ndarray, scale: np.ndarray) -> np.ndarray:
+                   lo_b: np.ndarray, hi_b: np.ndarray, scale: np.ndarray,
+                   ftol: float = _FTOL, max_nfev: int | None = None) -> np.ndarray:
     """The bounded trust-region fit of ``resid`` from ``p0`` (its stopping rule above)."""
     sol = _opt.least_squares(resid, p0, method="trf", bounds=(lo_b, hi_b), xtol=_XTOL,
-                             ftol=_FTOL, gtol=_FTOL, x_scale=scale)
+                             ftol=ftol, gtol=ftol, x_scale=scale, max_nfev=max_nfev)
     return sol.x
 
 
 def line_from_image(a: np.ndarray, x: np.ndarray, y: np.ndarray, iy: int, ix: int,
-                     max_length: float, lam_m: float) -> np.ndarray:
+                    max_length: float, lam_m: float) -> np.ndarray:
     """A line's start (x, y, azimuth, length) from a migrated image's plane that holds the
-    brightest pixel: the pixels above half of it that connect to it, their
-    intensity-weighted centre and principal axis, and their extent along it."""
+    brightest pixel: the straight line through that pixel along which the image is
+    brightest (its mean over directions 1 degree apart: a bar that crosses another is
+    followed, not merged with it), and the stretch of that line above half the pixel's
+    value that holds the pixel (its centre and extent)."""
     from scipy import ndimage
 
     plane = a.reshape((-1, *a.shape[-3:])).max(axis=0)
     iz = int(np.argmax(plane[:, iy, ix]))
     p = plane[iz]
-    labels, _ = ndimage.label(p >= 0.5 * p[iy, ix])
-    sel = labels == labels[iy, ix]
-    X, Y = np.meshgrid(x, y)
-    w = p[sel] ** 2
-    cx, cy = float(np.average(X[sel], weights=w)), float(np.average(Y[sel], weights=w))
-    dx, dy = X[sel] - cx, Y[sel] - cy
-    cov = np.cov(np.stack([dx, dy]), aweights=w) if sel.sum() > 2 else np.eye(2)
-    _, vecs = np.linalg.eigh(cov)
-    t = vecs[:, -1]
-    along = dx * t[0] + dy * t[1]
-    length = float(np.clip(np.ptp(along) + 2 * float(abs(x[1] - x[0])), 2 * lam_m,
-                           max_length))
-    return np.array([cx, cy, float(np.arctan2(t[1], t[0])), length])
+    dx, dy = float(x[1] - x[0]) if x.size > 1 else 1.0, float(y[1] - y[0]) if y.size > 1 else 1.0
+    step = 0.5 * min(abs(dx), abs(dy))
+    reach = float(np.hypot(np.ptp(x), np.ptp(y)))
+    s = np.arange(-reach, reach + step / 2, step)
+    phis = np.radians(np.arange(0.0, 180.0, 1.0))
+    cols = ix + s[None, :] * np.cos(phis)[:, None] / dx           # (directions, samples)
+    rows = iy + s[None, :] * np.sin(phis)[:, None] / dy
+    inside = (cols >= 0) & (cols <= p.shape[1] - 1) & (rows >= 0) & (rows <= p.shape[0] - 1)
+    vals = ndimage.map_coordinates(p, [rows.ravel(), cols.ravel()], order=1,
+                                   mode="nearest").reshape(rows.shape)
+    score = np.where(inside, vals, 0.0).sum(axis=1) / np.maximum(inside.sum(axis=1), 1)
+    k = int(np.argmax(score))
+    phi = float(phis[k])
+    above = inside[k] & (vals[k] >= 0.5 * p[iy, ix])
+    i0 = int(np.argmin(np.abs(s)))
+    lo = hi = i0
+    while lo > 0 and above[lo - 1]:
+        lo -= 1
+    while hi < s.size - 1 and above[hi + 1]:
+        hi += 1
+    mid = 0.5 * (s[lo] + s[hi])
+    length = float(np.clip(s[hi] - s[lo] + 2 * abs(dx), 2 * lam_m, max_length))
+    return np.array([float(x[ix]) + mid * np.cos(phi), float(y[iy]) + mid * np.sin(phi), phi,
+                     length])

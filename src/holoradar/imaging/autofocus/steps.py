@@ -3,10 +3,10 @@
 Locate the object (laterally from a migrated image, its range from the point fit),
 test it against noise at a middle eps', sweep eps' coarsely, refine every local
 maximum (and, across frequencies, every eps' where curvature and an alias of the
-delay agree), then at the best one the noise statistics, the interval and the check
-for rivals. A step that finds the scene gives no handle on eps' raises
-:class:`NoHandleError` with the reason; :meth:`Run.finish` makes the result either way
-(falling back on the glare's estimate where there is one).
+delay agree), then at the best one the noise statistics, the interval, the check
+for rivals and the Cramér-Rao bound. A step that finds the scene gives no handle on
+eps' raises :class:`NoHandleError` with the reason; :meth:`Run.finish` makes the result
+either way (falling back on the glare's estimate where there is one).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import numpy as np
 from ..._lazy import lazy_module
 from ...data.hologram import C0
 from ...physics.medium import Medium
+from .crb import crb_note, eps_bound
 from .fit_statistics import fit_statistics, no_object_reason
 from .glare_estimate import combine, glare_alone
 from .interval import crossing, focus_drop, quantile
@@ -78,17 +79,25 @@ def estimate(run: Run, depth_range: Any, position: Any, target: Any) -> dict[str
     """The steps, each raising ``NoHandleError`` where the scene gives no handle on eps';
     the result's fields when it does."""
     search = run.search
-    # 1. Where is the object? Laterally the brightest column of a migrated image; its
-    #    range, curvature and delay from the point fit along that column.
-    _locate(run, depth_range, position)
-    # 2. Is there an object at all? Fit one at a middle eps' and test it against noise.
-    grid = np.geomspace(run.lo, run.hi, COARSE)
-    mid = float(grid[len(grid) // 2])
-    _detect(run, mid)
-    # 3. Coarse sweep of eps' outwards from there, each with its best range and position;
-    #    every local maximum refined.
-    _sweep(search, grid, mid, target)
-    modes = _refine(search, _seeds(search, grid, run.lo, run.hi), run.lo, run.hi)
+    if target == "line":
+        # 1-3 for a line: a fast model on part of the data, then the exact one on all of
+        # it (line_search.py); run.search becomes the search on all the data.
+        from .line_search import line_steps
+
+        modes = line_steps(run, depth_range, position)
+        search = run.search
+    else:
+        # 1. Where is the object? Laterally the brightest column of a migrated image; its
+        #    range, curvature and delay from the point fit along that column.
+        _locate(run, depth_range, position)
+        # 2. Is there an object at all? Fit one at a middle eps' and test it against noise.
+        grid = np.geomspace(run.lo, run.hi, COARSE)
+        mid = float(grid[len(grid) // 2])
+        _detect(run, mid)
+        # 3. Coarse sweep of eps' outwards from there, each with its best range and
+        #    position; every local maximum refined.
+        _sweep(search, grid, mid, target)
+        modes = _refine(search, _seeds(search, grid, run.lo, run.hi), run.lo, run.hi)
     # 4. Noise level, detection and the sandwich factor at the optimum.
     e_hat, F_max, stats, common = _optimum(run)
     # 5. Profile-likelihood interval, R(eps) - R_min <= (q s sqrt(phi) + sqrt(E_err))^2, in
@@ -99,13 +108,17 @@ def estimate(run: Run, depth_range: Any, position: Any, target: Any) -> dict[str
     interval = (ends[0], ends[1])
     _check_rivals(search, e_hat, interval, level, modes, common)
     r_int = tuple(sorted((search.best[ends[0]][1], search.best[ends[1]][1])))
+    # 7. The Cramér-Rao bound at the estimate, and why the interval exceeds it.
+    _, z_hat, xy_hat = search.best[e_hat]
+    bound = eps_bound(search, e_hat, z_hat, xy_hat, stats)
     est, est_int = e_hat, interval
     reason = "from the focus"
     if run.glare is not None:
         est, est_int, reason = combine(e_hat, interval, run.glare, q)
     return dict(eps=float(est), eps_interval=est_int, determinable=True, reason=reason,
                 range_interval=(float(r_int[0]), float(r_int[1])), eps_focus=e_hat,
-                eps_focus_interval=interval, medium=run.make(float(est)), **common)
+                eps_focus_interval=interval, medium=run.make(float(est)), eps_crb=bound.std,
+                crb_note=crb_note(bound, interval, q, stats, F_max), **common)
 
 
 def _locate(run: Run, depth_range: Any, position: Any) -> None:
