@@ -129,10 +129,9 @@ def test_image_command_reads_and_writes_netcdf_and_never_destroys_data(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["holo.nc", "img.nc", "img.png"]
 
 
-def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch, tmp_path):
-    """The third panel's title ran off the figure ('... to L = 37.6 c'); the glare figure
-    wrote z_m = 2 z0 - z_s without saying what z0 and z_s are."""
-    from holoradar.app import demo, plotting
+def _kept_figures(monkeypatch) -> list:
+    """The figures the demo draws, kept as it turns them into PNGs."""
+    from holoradar.app import plotting
 
     figs = []
     real = plotting.to_png
@@ -142,6 +141,15 @@ def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch, tmp
         return real(fig, *args, **kwargs)
 
     monkeypatch.setattr(plotting, "to_png", keep)
+    return figs
+
+
+def test_demo_titles_fit_their_figures_and_define_their_symbols(monkeypatch, tmp_path):
+    """The third panel's title ran off the figure ('... to L = 37.6 c'); the glare figure
+    wrote z_m = 2 z0 - z_s without saying what z0 and z_s are."""
+    from holoradar.app import demo
+
+    figs = _kept_figures(monkeypatch)
     demo.run_demo(tmp_path / "demo", upsample=1)
     assert len(figs) == 5
     for fig in figs:
@@ -167,16 +175,9 @@ def test_demo_spectrum_window_is_where_the_summary_says(monkeypatch, tmp_path):
     the summary says both numbers."""
     from matplotlib.patches import Rectangle
 
-    from holoradar.app import demo, plotting
+    from holoradar.app import demo
 
-    figs = []
-    real = plotting.to_png
-
-    def keep(fig, *args, **kwargs):
-        figs.append(fig)
-        return real(fig, *args, **kwargs)
-
-    monkeypatch.setattr(plotting, "to_png", keep)
+    figs = _kept_figures(monkeypatch)
     s = demo.run_demo(tmp_path / "demo", upsample=1)
     p0, q0 = s["theory"]["illumination_p0_q0_rad_per_m"]
     assert q0 > 0 and abs(p0) < 1e-9

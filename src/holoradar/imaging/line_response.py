@@ -71,18 +71,8 @@ class LineResponse(PointResponse):
                  coherent: bool, radius: float, eps_line: complex | None = None,
                  phase_only: bool = False) -> None:
         super().__init__(hologram, make_medium, coherent=coherent, phase_only=phase_only)
-        if not self.vector or self.monostatic:
-            raise ValueError("target='line' needs the vector model with a separate source: a "
-                             "hologram with a polarization (the recorded field component) "
-                             "and a polarised source (a Dipole, or a source given a "
-                             "polarization)")
-        if not (self.flat and hologram.pose.is_identity):
-            raise ValueError("target='line' needs an untilted aperture (a tilted one is not "
-                             "modelled for lines)")
-        self.radius = float(radius)
-        self.eps_line = eps_line
+        _line_setup(self, hologram, radius, eps_line)
         # Nodes reach half a line beyond its centre: tables long enough for the longest.
-        self.max_length = MAX_LENGTH * float(max(np.ptp(hologram.x), np.ptp(hologram.y)))
         self._rho_max += 0.5 * self.max_length
         if self._point_source:
             self._rho_max_src += 0.5 * self.max_length
@@ -172,6 +162,15 @@ def _along(G: Any, row: np.ndarray, rho: np.ndarray) -> np.ndarray:
     return vals[:, :5] * np.exp(1j * vals[:, 5].real)[:, None, :]
 
 
+def _line_setup(pr: Any, hologram: Hologram, radius: float, eps_line: Any) -> None:
+    """What both line models set up: the model's checks, the cylinder, the longest line
+    (:data:`MAX_LENGTH` aperture widths)."""
+    _check_line_model(pr, hologram)
+    pr.radius = float(radius)
+    pr.eps_line = eps_line
+    pr.max_length = MAX_LENGTH * float(max(np.ptp(hologram.x), np.ptp(hologram.y)))
+
+
 def _check_line_model(pr: PointResponse, hologram: Hologram) -> None:
     """What both line models need: the vector model, a separate source, a flat grid."""
     if not pr.vector or pr.monostatic:
@@ -228,10 +227,7 @@ class LineRayResponse(PointResponse):
                  coherent: bool, radius: float, eps_line: complex | None = None,
                  phase_only: bool = False) -> None:
         super().__init__(hologram, make_medium, coherent=coherent, phase_only=phase_only)
-        _check_line_model(self, hologram)
-        self.radius = float(radius)
-        self.eps_line = eps_line
-        self.max_length = MAX_LENGTH * float(max(np.ptp(hologram.x), np.ptp(hologram.y)))
+        _line_setup(self, hologram, radius, eps_line)
         self._source = ray_source(hologram.source)
         self._grounds: dict[float, tuple[Medium, dict, dict]] = {}
         self.correction: np.ndarray | None = None   # (nf, N) factors, see correct_to

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -45,9 +45,6 @@ from ..migrate import migrate
 from .fit_statistics import fit_statistics
 from .interval import focus_drop, quantile
 from .search import Search, _least_squares
-
-if TYPE_CHECKING:
-    from .steps import Run
 
 _opt = lazy_module("scipy.optimize")
 
@@ -196,10 +193,17 @@ class WarmSearch(Search):
         return float(_opt.brentq(lambda zz: m_to.optical_path(zz).real - path, self.z0, top))
 
 
-def line_steps(run: Run, depth_range: Any, position: Any) -> list[float]:
+def line_steps(run: Any, depth_range: Any, position: Any, stages: Any) -> list[float]:
     """Steps 1-3 for a line (the module notes); leaves ``run.search`` the search on all
-    the data with the exact-corrected model, and returns the modes of eps'."""
-    from .steps import COARSE, _detect, _locate, _refine, _seeds, _sweep
+    the data with the exact-corrected model, and returns the modes of eps'.
+
+    ``run`` is the autofocus's run (:class:`.steps.Run`); ``stages`` the point search's
+    steps it reuses (``COARSE``, ``locate``, ``detect``, ``sweep``, ``refine``,
+    ``seeds``), handed over by :func:`.steps.estimate` (this module does not import it).
+    """
+    COARSE = stages.COARSE
+    _detect, _locate, _refine = stages.detect, stages.locate, stages.refine
+    _seeds, _sweep = stages.seeds, stages.sweep
 
     exact = run.search.pr
     full = run.search.hologram

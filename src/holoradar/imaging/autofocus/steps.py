@@ -82,9 +82,13 @@ def estimate(run: Run, depth_range: Any, position: Any, target: Any) -> dict[str
     if target == "line":
         # 1-3 for a line: a fast model on part of the data, then the exact one on all of
         # it (line_search.py); run.search becomes the search on all the data.
+        from types import SimpleNamespace
+
         from .line_search import line_steps
 
-        modes = line_steps(run, depth_range, position)
+        stages = SimpleNamespace(COARSE=COARSE, locate=_locate, detect=_detect,
+                                 sweep=_sweep, refine=_refine, seeds=_seeds)
+        modes = line_steps(run, depth_range, position, stages)
         search = run.search
     else:
         # 1. Where is the object? Laterally the brightest column of a migrated image; its
