@@ -360,3 +360,37 @@ def test_the_search_runs_its_blas_on_one_thread(monkeypatch):
         # a narrow search: every trial's match is checked, not the answer
         hr.autofocus(h, medium_model=hr.Medium.half_space(0.30, 3.0), eps_range=(3.0, 5.0))
     assert seen and max(seen) == 1
+
+
+def test_progress_total_only_grows_and_the_bar_ends_full(monkeypatch):
+    """The bar's total never shrinks (it made room as the work showed itself) and the bar
+    ends at its total: no 26 -> 58 -> 37."""
+    from holoradar.imaging.autofocus import api
+
+    totals = []
+
+    class Bar:
+        def __init__(self, total):
+            self.n, self.total = 0, total
+            totals.append(total)
+
+        def update(self, k=1):
+            self.n += k
+
+        def refresh(self):
+            totals.append(self.total)
+
+        def close(self):
+            totals.append(self.total)
+
+    bars = []
+    monkeypatch.setattr(api, "_progress_bar", lambda target, progress: bars.append(
+        Bar(api.COARSE + 16)) or bars[-1])
+    truth = hr.Medium.half_space(0.30, 4.0)
+    scene = hr.Scene(truth, hr.PlaneWave(), [hr.PointTarget((0.01, 0.0, 0.45))])
+    h = hr.simulate(scene, hr.Aperture.paper(), 9.9e9, include_surface=False, snr_db=40,
+                    seed=0)
+    res = hr.autofocus(h, medium_model=hr.Medium.half_space(0.30, 3.0), progress=True)
+    assert res.determinable
+    assert all(b >= a for a, b in zip(totals, totals[1:], strict=False)), totals
+    assert bars[0].n == bars[0].total

@@ -188,5 +188,5 @@ def _progress_bar(target: Any, progress: bool) -> Any:
     expected = 2 + COARSE * (2 if target == "line" else 1) + 14
     from tqdm.auto import tqdm
 
-    return tqdm(total=expected, desc="autofocus", unit="trial", disable=not progress,
+    return tqdm(total=expected, desc="autofocus", unit="step", disable=not progress,
                 delay=1.0)

@@ -44,6 +44,7 @@ from ..line_response import LineRayResponse, LineResponse, LineSetResponse, ray_
 from ..migrate import migrate
 from .fit_statistics import fit_statistics
 from .interval import focus_drop, quantile
+from .progress import make_room
 from .search import Search, _least_squares
 
 _opt = lazy_module("scipy.optimize")
@@ -323,7 +324,7 @@ class SetSearch(WarmSearch):
             return self.best[eps]
         if self.bar is not None:
             if self.bar.n + 1 >= self.bar.total:
-                self.bar.total = self.bar.n + 4
+                make_room(self.bar, 4)
             self.bar.update()
         self.fit_lines(eps)
         pr = self.pr

@@ -21,6 +21,7 @@ from ...data.hologram import C0, Hologram
 from ...physics.medium import Medium
 from ..migrate import migrate
 from ..point_response import PointResponse
+from .progress import make_room
 
 _opt = lazy_module("scipy.optimize")
 
@@ -192,7 +193,7 @@ class Search:
             return self.best[eps]
         if self.bar is not None:
             if self.bar.n + 1 >= self.bar.total:
-                self.bar.total = self.bar.n + 4   # more than expected: keep room
+                make_room(self.bar, 4)   # more than expected: keep room
             self.bar.update()
         pr = self.pr
         floor = self.z0 + pr.spacing(eps) / 4

@@ -25,6 +25,7 @@ from .crb import crb_note, eps_bound
 from .fit_statistics import fit_statistics, no_object_reason
 from .glare_estimate import combine, glare_alone
 from .interval import crossing, focus_drop, quantile
+from .progress import finish_bar, make_room
 from .result import AutofocusResult
 from .search import Search
 
@@ -67,9 +68,7 @@ class Run:
         kw = {**self.base, **kw}
         if not kw.get("determinable", True) and self.glare is not None:
             kw.update(glare_alone(self.glare, self.confidence, self.make, kw["reason"]))
-        bar.total = bar.n
-        bar.refresh()
-        bar.close()
+        finish_bar(bar)   # the total never shrinks; the steps not needed count as done
         return AutofocusResult(eps_grid=grid, profile=prof, evaluations=search.pr.responses,
                                integrals=search.pr.integrals,
                                seconds=time.perf_counter() - self.t_start, **kw)
@@ -178,8 +177,7 @@ def _refine(search: Search, seeds: list[tuple[float, float, float]], lo: float,
     (refined or not), checked for rivals once the interval is known."""
     bar = search.bar
     # Now the work left is known better: about 8 trials a refined seed, 7 for the interval.
-    bar.total = max(bar.total, bar.n + 8 * len(seeds) + 7)
-    bar.refresh()
+    make_room(bar, 8 * len(seeds) + 7)
     modes = []
     for a, c, b in seeds:
         F_c = search.evaluate(c)[0]
