@@ -8,6 +8,8 @@ is checked against independent full-wave data at the end (SMUTHI sphere).
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
