@@ -115,7 +115,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
               position=at, glare=glare_arg, fit=fit, confidence=confidence,
               target=target, line_radius=line_radius, progress=report.progress)
     files = []
-    lines = [str(res)]
+    lines = [str(res), *([res.crb_note] if res.crb_note else [])]
     if plot_file is not None:
         if res.eps_grid.size > 1:
             _plot(res, plot_file, hologram_file.name)
@@ -128,6 +128,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
     summary = {
         "determinable": res.determinable, "eps": res.eps,
         "eps_interval": res.eps_interval, "confidence": res.confidence,
+        "eps_crb": res.eps_crb, "crb_note": res.crb_note,
         "reason": res.reason, "position_m": res.position, "depth_m": res.depth,
         "range_interval_m": res.range_interval, "eps_focus": res.eps_focus,
         "eps_glare": res.eps_glare, "eps_glare_std": res.eps_glare_std,

@@ -125,7 +125,10 @@ class AutofocusResult:
         # Enough decimals that the interval's width shows (2 at least).
         d = max(2, 1 - int(np.floor(np.log10(max(hi - lo, 1e-12)))))
         text = (f"eps' = {self.eps:.{d}f} ({100 * self.confidence:.0f}% interval {lo:.{d}f} .. "
-                f"{hi:.{d}f})")
+                f"{hi:.{d}f}")
+        if self.eps_crb is not None:   # what the data could tell at best, beside it
+            text += f"; Cramér-Rao bound's sigma {self.eps_crb:.2g}"
+        text += ")"
         if self.position is not None and self.depth is not None:
             text += (f"; object at range {self.position[2]:.4g} m, {self.depth:.4g} m below the "
                      "surface")
