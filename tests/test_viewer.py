@@ -582,3 +582,11 @@ def test_ctrl_c_stops_the_viewer_with_one_line_and_exit_130(tmp_path, monkeypatc
     assert res.exit_code == 130, res.output
     assert res.output.strip().splitlines()[-1].startswith("interrupted: the viewer stopped")
     assert stopped == [True]
+
+
+def test_glare_table_says_a_rough_eps_without_rounding_residue():
+    """The Gaussian fit's eps has no sigma: two digits and "rough", no 3.1e-23j."""
+    from holoradar.app.view.page.figures import _fmt_eps
+
+    assert _fmt_eps(2.64 + 3.1e-23j, None) == "about 2.6 (rough: no σ from this method)"
+    assert "e-" not in _fmt_eps(2.64 + 3.1e-23j, None)

@@ -34,8 +34,9 @@ def _fmt_eps(e: complex | None, std: tuple[float, float] | None) -> str:
     them."""
     if e is None:
         return "-"
-    if std is None:
-        return f"{e.real:.3g}{e.imag:+.2g}j (no σ from this method)"
+    if std is None:   # a rough estimate: two digits, no rounding residue as eps''
+        imag = f"{e.imag:+.1g}j " if abs(e.imag) > 1e-3 * abs(e.real) else " "
+        return f"about {e.real:.2g}{imag}(rough: no σ from this method)"
     return f"{e.real:.3g} ± {std[0]:.2g}, {e.imag:+.2g} ± {std[1]:.2g}j"
 
 
