@@ -198,10 +198,12 @@ def kernels(plan: MigrationPlan, k: float, medium: Medium | None = None) -> np.n
     top = max(float(rho_rx.max()), float(rho_tx.max()))
     grid = np.arange(0.0, top + 3 * step, step)
     out = np.ones((plan.z.size, *rho_rx.shape), dtype=complex)
+    profiles: dict[float, tuple[np.ndarray, np.ndarray]] = {}
     for z_antenna, rho in ((0.0, rho_rx), (float(dz), rho_tx)):
-        prof = transmitted_profiles(k, m, z_antenna, plan.z, grid)
-        amp = np.abs(prof)
-        phase = np.unwrap(np.angle(prof), axis=-1)
+        if z_antenna not in profiles:   # both antennas at one height (dz = 0): one integral
+            prof = transmitted_profiles(k, m, z_antenna, plan.z, grid)
+            profiles[z_antenna] = (np.abs(prof), np.unwrap(np.angle(prof), axis=-1))
+        amp, phase = profiles[z_antenna]
         for j in range(plan.z.size):
             out[j] *= np.interp(rho, grid, amp[j]) * np.exp(1j * np.interp(rho, grid,
                                                                          phase[j]))
