@@ -526,8 +526,8 @@ def test_image_says_a_large_output_and_refuses_what_the_disk_cannot_hold(holo_nc
 
 def test_suppress_says_eps_with_its_uncertainty_or_that_it_is_rough(tmp_path):
     """The exact glare fit's eps with its 1-sigma and 95 % interval (digits from the
-    sigma, no rounding residue as eps''); the Gaussian fit's eps marked rough with the
-    way to an uncertainty; both in --json."""
+    sigma, no rounding residue as eps''), with either method; the Gaussian fit's own
+    eps in --json, marked rough."""
     run("demo", "--out", tmp_path / "d", "--upsample", "1", "--quiet")
     h = tmp_path / "d" / "hologram.nc"
     res = run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "--method", "image_source",
@@ -540,6 +540,13 @@ def test_suppress_says_eps_with_its_uncertainty_or_that_it_is_rough(tmp_path):
     lo, hi = d["eps_interval_95"]
     assert lo < d["eps"][0] < hi and d["eps_std"][0] > 0
     assert lo < 2.5 < hi   # the demo's sand
-    res = run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "-o", tmp_path / "c.nc")
+    # The default (Gaussian) method removes the glare; the eps it prints is the exact
+    # fit's, with its interval, the Gaussian's own in --json as rough.
+    d = json.loads(run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "--no-direct",
+                       "-o", tmp_path / "c.nc", "--json").stdout)
+    lo, hi = d["eps_interval_95"]
+    assert lo < 2.5 < hi and d["eps_gaussian_rough"][0] > 1 and "exact" in d["eps_from"]
+    res = run("suppress", h, "--eps", "2.5", "--z-surface", "0.30", "--no-direct",
+              "-o", tmp_path / "e.nc")
     line = next(ln for ln in res.output.splitlines() if "permittivity" in ln)
-    assert "rough, no uncertainty" in line and "image_source" in line, line
+    assert "exact glare fit" in line and "+-" in line and "e-" not in line, line

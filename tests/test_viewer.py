@@ -590,3 +590,12 @@ def test_glare_table_says_a_rough_eps_without_rounding_residue():
 
     assert _fmt_eps(2.64 + 3.1e-23j, None) == "about 2.6 (rough: no σ from this method)"
     assert "e-" not in _fmt_eps(2.64 + 3.1e-23j, None)
+
+
+def test_glare_table_gives_the_exact_fit_eps_with_its_sigma():
+    """With a sigma: digits from it and no rounding residue as eps''."""
+    from holoradar.app.view.page.figures import _fmt_eps
+
+    text = _fmt_eps(2.641972 + 3.2e-23j, (0.5656, 0.5656))
+    assert text.startswith("eps' = 2.64 ± 0.57 (95 %: 1.53 .. 3.75)"), text
+    assert "e-" not in text

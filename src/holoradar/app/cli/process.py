@@ -110,8 +110,11 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
     background = read_hologram(background_file, layout, check) if background_file else None
     src = _sources(horns, (), pattern, 1)
     t0 = time.perf_counter()
+    # The printed eps comes from the exact glare fit, with its uncertainty, whichever
+    # method removes the glare (the Gaussian's own estimate is rough).
     clean, rep = suppress_surface(holo, medium, None if src is None else src[0], method,
-                                  background=background, direct=not no_direct)
+                                  background=background, direct=not no_direct,
+                                  exact_eps=method == "gaussian")
     seconds = time.perf_counter() - t0
     save(clean, out, overwrite=force, history=[*input_history(hologram_file, layout), {
         "step": "suppress_surface", "input": hologram_file.name,
@@ -123,12 +126,19 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
     rough = ("" if rep.eps_std is not None else
              f"from the {method} fit's glare strength; --method image_source fits the exact "
              "glare with its uncertainty")
+    rough_gaussian = rep.parameters.get("eps_gaussian")
+    extra = {} if rough_gaussian is None else {
+        "eps_from": "the exact glare fit (image_source)",
+        "eps_gaussian_rough": [rough_gaussian.real, rough_gaussian.imag]}
     s = {"out": str(out), "method": method, "glare_suppression_db": rep.glare_suppression_db,
          "glare_removed_db": rep.glare_removed_db, **eps_summary(rep.eps, rep.eps_std, rough),
+         **extra,
          "mirror_position_m": rep.mirror_position, "converged": rep.converged,
          "seconds": seconds}
+    how = "" if rough_gaussian is None else " (exact glare fit)"
     eps_line = [] if rep.eps is None else [
-        f"ground permittivity from the glare: {eps_text(rep.eps, rep.eps_std, rough=rough)}"]
+        f"ground permittivity from the glare{how}: "
+        f"{eps_text(rep.eps, rep.eps_std, rough=rough)}"]
     report.done(s, [
         f"glare suppressed by {rep.glare_suppression_db:.1f} dB at its mirror spot "
         f"({method}{'' if rep.converged else ', fit did not converge'}) in {seconds:.1f} s",

@@ -378,8 +378,13 @@ class ViewSession:
                 with warnings.catch_warnings(record=True) as said:
                     warnings.simplefilter("always")
                     if h.is_wideband:  # one fit per frequency: the glare's phase moves with f
+                        # eps (exact fit, with its sigma) from the middle frequency's,
+                        # the one the table shows
                         parts = [suppress_surface(h.at_frequency(i), medium, method=s.glare,
-                                                  direct=s.direct) for i in range(h.nf)]
+                                                  direct=s.direct,
+                                                  exact_eps=s.glare == "gaussian"
+                                                  and i == h.nf // 2)
+                                 for i in range(h.nf)]
                         clean = h.with_data(np.stack([c.data for c, _ in parts], axis=-3))
                         rep = parts[h.nf // 2][1]
                         left = [float(np.linalg.norm(c.data)) ** 2 for c, _ in parts]
@@ -387,7 +392,8 @@ class ViewSession:
                         direct = _summed_db(left, [r.direct_removed_db for _, r in parts])
                     else:
                         clean, rep = suppress_surface(h, medium, method=s.glare,
-                                                      direct=s.direct)
+                                                      direct=s.direct,
+                                                      exact_eps=s.glare == "gaussian")
                         removed, direct = rep.glare_removed_db, rep.direct_removed_db
             except ValueError as exc:
                 out.append(h)

@@ -144,7 +144,8 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                      direct: bool = True, cut_radius: float | None = None, taper: bool = True,
                      reference_amplitude: complex | None = None,
                      fit_domain: Literal["mirror", "aperture"] = "aperture",
-                     initial: dict[str, Any] | None = None) -> tuple[Hologram, SuppressionReport]:
+                     initial: dict[str, Any] | None = None,
+                     exact_eps: bool = False) -> tuple[Hologram, SuppressionReport]:
     """Remove the surface glare (and the direct wave) from a hologram.
 
     Parameters
@@ -192,6 +193,16 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         the letter damaged, against 22.2 dB and the letter kept on the elements).
     initial : dict, optional
         ``report.parameters`` of a previous frame, to warm-start the fit.
+    exact_eps : bool
+        ``"gaussian"`` with a point radiator or dipole: take the report's ``eps`` and
+        ``eps_std`` from the exact image-source fit of the same data (what
+        :func:`~holoradar.estimate_permittivity` does; about as long again as the
+        Gaussian fit) instead of the beam's strength, which is rough (no
+        uncertainty; 5-15 % off where the beam shape does not match the radiator's
+        glare). The Gaussian's own estimate is then ``parameters["eps_gaussian"]``.
+        The amplitude reference is the Gaussian's: the direct wave where one was found
+        in the data, else ``reference_amplitude`` or the source's. Default False
+        (the cleaned hologram is the same either way).
 
     Returns
     -------
@@ -350,8 +361,9 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
         # The radiator's amplitude: given, or the direct wave's when one was found (it
         # carries at least 1% of the hologram's energy), else the source's own.
         ref = reference_amplitude
-        if ref is None and D is not None and dcoef is not None and (
-                np.sum(np.abs(direct_part) ** 2) > 0.01 * np.sum(np.abs(h) ** 2)):
+        from_direct = ref is None and D is not None and dcoef is not None and bool(
+            np.sum(np.abs(direct_part) ** 2) > 0.01 * np.sum(np.abs(h) ** 2))
+        if from_direct:
             ref = dcoef
         if ref is None:
             ref = src.amplitude
@@ -363,11 +375,26 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
                           "calibration of the radiator) to estimate eps", FitWarning,
                           stacklevel=2)
         report_kw.update(reflection_coefficient=V, eps=eps)
+        if exact_eps:
+            report_kw["parameters"] = dict(params, eps_gaussian=eps)
+            report_kw.update(_exact_eps(hologram, medium, src, complex(ref), from_direct))
     if not converged:
         warnings.warn(f"suppress_surface: the {method} fit did not converge; the glare may "
                       "be only partly removed", FitWarning, stacklevel=2)
     return hologram.with_data(cleaned.reshape(data.shape)), SuppressionReport(method,
                                                                                **report_kw)
+
+
+def _exact_eps(hologram: Hologram, medium: Medium, src: Any, ref: complex,
+               direct: bool) -> dict[str, Any]:
+    """eps and its 1-sigma from the exact image-source fit (started from ``medium``'s
+    eps), with the Gaussian's amplitude reference: the direct wave in the data, or
+    ``ref``."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitWarning)   # the caller's own fit says its own
+        _, rep = suppress_surface(hologram, medium, src, "image_source", direct=direct,
+                                  reference_amplitude=None if direct else ref)
+    return {"eps": rep.eps, "eps_std": rep.eps_std}
 
 
 def _world(pose: Any, x: float, y: float, z: float) -> tuple[float, float, float]:

@@ -12,6 +12,7 @@ import html
 
 import numpy as np
 
+from ...eps_text import eps_text
 from ..display import CM, db, peak_of, scaled, sections
 from .layout import PLAN_MAX_WIDTH, PLAN_MIN_WIDTH, SECTION_WIDTH
 
@@ -37,7 +38,7 @@ def _fmt_eps(e: complex | None, std: tuple[float, float] | None) -> str:
     if std is None:   # a rough estimate: two digits, no rounding residue as eps''
         imag = f"{e.imag:+.1g}j " if abs(e.imag) > 1e-3 * abs(e.real) else " "
         return f"about {e.real:.2g}{imag}(rough: no σ from this method)"
-    return f"{e.real:.3g} ± {std[0]:.2g}, {e.imag:+.2g} ± {std[1]:.2g}j"
+    return eps_text(e, std).replace("+-", "±")   # digits from sigma; no eps'' residue
 
 
 # The cursor readout, in the browser: x, y from the pointer, the value from the shown plane.
