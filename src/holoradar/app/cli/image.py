@@ -32,7 +32,6 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
     """Write an image as .nc (with its history) or .npz, and a PNG of its brightest plane."""
     from ...analysis.metrics import peak_position
     from ...io import save
-    from .. import plotting
     from ..atomic import write_atomic
 
     if out.suffix.lower() in (".nc", ".nc4"):
@@ -47,6 +46,8 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
         write_atomic(out, buf.getvalue())
     files = [str(out)]
     if png:
+        from .. import plotting   # matplotlib: 0.3-0.6 s to import, only for the picture
+
         pk = peak_position(img)
         fig = plotting.plot_image([img.plane(pk[2])], [title])
         write_atomic(out.with_suffix(".png"), plotting.to_png(fig))
