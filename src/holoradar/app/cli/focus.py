@@ -9,6 +9,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..numbers import cm
 from .common import (
     Reporter,
     array_of,
@@ -51,13 +52,16 @@ def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
 @click.option("--fit", type=click.Choice(["field", "phase"]), default="field",
               show_default=True, help="Match the complex field, or its phases only (for "
                                       "arrays whose element amplitudes are not calibrated).")
-@click.option("--target", type=click.Choice(["point", "line"]), default="point",
+@click.option("--target", type=click.Choice(["point", "line", "sphere"]), default="point",
               show_default=True,
-              help="The object fitted: a compact one, or a horizontal bar or pipe (needs a "
-                   "polarised hologram and source; slow).")
+              help="The object fitted: a compact one, a horizontal bar or pipe, or a "
+                   "conducting sphere of --sphere-radius (line and sphere need a "
+                   "polarised hologram and source).")
 @click.option("--line-radius", default=0.006, show_default=True,
               type=click.FloatRange(0, min_open=True), metavar="M",
               help="The bar's radius for --target line, m.")
+@click.option("--sphere-radius", default=None, type=click.FloatRange(0, min_open=True),
+              metavar="M", help="The sphere's radius for --target sphere (required there), m.")
 @click.option("--confidence", default=0.95, show_default=True,
               type=click.FloatRange(0, 1, min_open=True, max_open=True))
 @click.option("--plot", "plot_file", default=None,
@@ -69,7 +73,7 @@ def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
 def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
               depth_range: str | None, position: str | None, glare: bool,
               glare_estimate: str | None, fit: str, target: str, line_radius: float,
-              confidence: float, plot_file: Path | None,
+              sphere_radius: float | None, confidence: float, plot_file: Path | None,
               force: bool, layout: str | None, check: bool, report: Reporter) -> None:
     """Find the ground permittivity that focuses a buried object best.
 
@@ -81,6 +85,10 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
     from ...imaging.autofocus import autofocus as run
     from ...io.output import check_output
 
+    if (target == "sphere") != (sphere_radius is not None):
+        raise click.BadParameter("--target sphere needs --sphere-radius (the sphere's radius in "
+                                 "metres), and --sphere-radius needs --target sphere",
+                                 param_hint="--sphere-radius")
     eps_pair = _pair(eps_range, "--eps-range")
     depth_pair = None if depth_range is None else _pair(depth_range, "--depth-range")
     at = None if position is None else _pair(position, "--at", "X,Y")
@@ -113,7 +121,8 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
                               f"surface at {surface:.4g} m", offset=surface)
     res = run(holo, medium_model=medium, eps_range=eps_pair, depth_range=depth_pair,
               position=at, glare=glare_arg, fit=fit, confidence=confidence,
-              target=target, line_radius=line_radius, progress=report.progress)
+              target=target, line_radius=line_radius, sphere_radius=sphere_radius,
+              progress=report.progress)
     files = []
     lines = [str(res), *([res.crb_note] if res.crb_note else [])]
     if plot_file is not None:
@@ -138,7 +147,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
     }
     if res.position is not None:
         x, y, z = res.position
-        lines.append(f"object at x={100 * x:.1f} y={100 * y:.1f} cm, range {100 * z:.1f} cm")
+        lines.append(f"object at x={cm(x)} y={cm(y)} cm, range {cm(z)} cm")
     if res.line_azimuth_deg is not None and res.line_length is not None:
         lines.append(f"line azimuth {res.line_azimuth_deg:.1f} deg from +x, length "
                      f"{100 * res.line_length:.1f} cm")

@@ -11,6 +11,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..numbers import cm
 from .common import (
     Reporter,
     check_planes,
@@ -46,7 +47,7 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
         write_atomic(out, buf.getvalue())
     files = [str(out)]
     if png:
-        from .. import plotting   # matplotlib: 0.3-0.6 s to import, only for the picture
+        from .. import plotting  # matplotlib: 0.3-0.6 s to import, only for the picture
 
         pk = peak_position(img)
         fig = plotting.plot_image([img.plane(pk[2])], [title])
@@ -131,7 +132,7 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
                  "shape": list(img.data.shape), "seconds": seconds}, [
         f"imaged {hologram_file.name}: {img.z.size} plane(s), {img.x.size} x {img.y.size} "
         f"pixels, in {seconds:.1f} s",
-        f"brightest point x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
+        f"brightest point x={cm(pk[0])} y={cm(pk[1])} z={cm(pk[2])} cm",
         *[f"wrote {f}" for f in files],
     ], result=[f"wrote {f}" for f in files])
 

@@ -9,6 +9,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..numbers import cm
 from .common import (
     Reporter,
     check_planes,
@@ -99,7 +100,7 @@ def invert(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str
         f"{refl.y.size} voxels, {step['iterations']} steps in {seconds:.1f} s",
         f"stopped: {step['stop']}; residual {step['residual_over_noise']:.2f} x the noise "
         f"({step['noise']})",
-        f"brightest voxel x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
+        f"brightest voxel x={cm(pk[0])} y={cm(pk[1])} z={cm(pk[2])} cm",
         *[f"wrote {f}" for f in files],
     ], result=[f"wrote {f}" for f in files])
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..numbers import cm
 from .common import Reporter, check_ranges, output_options, triple
 
 __all__ = ["COMMANDS"]
@@ -46,10 +47,10 @@ def demo(out: Path, upsample: int, force: bool, report: Reporter) -> None:
         f"  depth resolution (FWHM)   {dz * 100:6.1f} cm in the sand: at one frequency depth "
         "is barely resolved",
         f"  glare / object at array   {s['glare_to_object_ratio_db']:6.1f} dB",
-        f"  image peak, targets only  x={pc[0] * 100:.1f} y={pc[1] * 100:.1f} "
+        f"  image peak, targets only  x={cm(pc[0])} y={cm(pc[1])} "
         f"z={pc[2] * 100:.1f} cm",
-        f"  glare: mirror image found x={mf[0] * 100:.1f} y={mf[1] * 100:.1f} cm at "
-        f"z={mf[2] * 100:.0f} cm (expected x={me[0] * 100:.1f} y={me[1] * 100:.1f})",
+        f"  glare: mirror image found x={cm(mf[0])} y={cm(mf[1])} cm at "
+        f"z={mf[2] * 100:.0f} cm (expected x={cm(me[0])} y={cm(me[1])})",
         f"  array pitch exceeds lambda/2: waves beyond {th['max_unaliased_angle_deg']:.0f} "
         "degrees off axis alias",
         f"  {wrote}",
@@ -164,7 +165,7 @@ def plan_oblique_cmd(n: int, pitch: float, center: str, tilt: float, azimuth: fl
     }
     sp = s["specular_point_m"]
     report.done(s, [
-        f"specular point       x={sp[0] * 100:.1f} y={sp[1] * 100:.1f} z={sp[2] * 100:.1f} cm",
+        f"specular point       x={cm(sp[0])} y={cm(sp[1])} z={cm(sp[2])} cm",
         f"miss distance        {s['miss_distance_m'] * 100:.1f} cm (> 0: the glare misses "
         "the array)",
         f"glare fraction       {s['glare_fraction']:.3f}",

@@ -10,6 +10,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..numbers import cm
 from .common import (
     Reporter,
     array_of,
@@ -212,7 +213,7 @@ def synthesize(hologram_files: tuple[Path, ...], z: str, medium_spec: dict[str, 
     report.done({"peak_m": pk, "out": str(out), "files": files, "views": len(views),
                  "seconds": seconds}, [
         f"synthesised {len(views)} views ({mode}) in {seconds:.1f} s",
-        f"brightest point x={pk[0] * 100:.1f} y={pk[1] * 100:.1f} z={pk[2] * 100:.1f} cm",
+        f"brightest point x={cm(pk[0])} y={cm(pk[1])} z={cm(pk[2])} cm",
         *[f"wrote {f}" for f in files],
     ], result=[f"wrote {f}" for f in files])
 

@@ -101,10 +101,10 @@ def check_fit(fit: Any) -> None:
 
 
 def check_target(target: Any) -> None:
-    """``target`` is ``"point"`` or ``"line"``."""
-    if target not in ("point", "line"):
-        raise ValueError(f"target must be 'point' (a compact object) or 'line' (rebar, pipe), "
-                         f"got {target!r}")
+    """``target`` is ``"point"``, ``"line"`` or ``"sphere"``."""
+    if target not in ("point", "line", "sphere"):
+        raise ValueError(f"target must be 'point' (a compact object), 'line' (rebar, pipe) or "
+                         f"'sphere' (a conducting ball of known radius), got {target!r}")
 
 
 def check_line_radius(line_radius: Any) -> float:
