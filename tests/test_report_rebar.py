@@ -109,6 +109,20 @@ def test_an_image_read_back_keeps_its_history(mat, tmp_path):
     assert "No processing history" not in html and "<b>save</b>" in html
 
 
+def test_a_loaded_image_gives_its_ground_from_the_history_it_carries(mat, tmp_path):
+    # No medium given: the image holoradar image made through the sand, read back into
+    # memory, says so in its history; the table's eps interval then widens the depths.
+    x = (np.arange(16) - 7.5) * 0.0125
+    holo = hr.save(hr.Hologram(np.ones((16, 16), complex), x, x, 9.9e9), tmp_path / "h.nc")
+    run("image", holo, "--z", "0.42", "--eps", "2.5+0.0125j", "--z-surface", "0.30",
+        "-o", tmp_path / "i.nc", "--no-png", "-q", "--no-check")
+    out = tmp_path / "r.html"
+    hr.report(hr.load(tmp_path / "i.nc"), out, detections=mat["df"])
+    html = out.read_text()
+    assert "the image&#x27;s history: the ground it was imaged through" in html
+    assert "2.2 to 2.8, the one the objects&#x27; table was found with" in html
+
+
 def test_the_images_warnings_travel_in_its_history(tmp_path):
     # holoradar image warns of the 2.5 cm pitch (aliased at 9.9 GHz); the report of the
     # image file lists that warning, from the file's history.

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-__all__ = ["history_medium", "read_hologram"]
+__all__ = ["history_medium", "medium_of_history", "read_hologram"]
 
 
 def read_hologram(path: Path, layout: Any, check: bool) -> Any:
@@ -31,7 +31,6 @@ def history_medium(path: Path) -> Any:
     """The ground a holoradar image file was made through: the medium of the last
     ``migrate`` step of its history; None for another file, a file without that step
     or a step imaged in free space (anything unreadable is None too)."""
-    from ..physics.medium import Medium
     from .netcdf import read_history
 
     if path.suffix.lower() not in (".nc", ".nc4"):
@@ -40,7 +39,22 @@ def history_medium(path: Path) -> Any:
         steps = read_history(path)
     except (ValueError, OSError):
         return None
-    for step in reversed(steps):
+    return medium_of_history(steps)
+
+
+def medium_of_history(steps: Any) -> Any:
+    """The medium of the last ``migrate`` step of a processing history (a list of step
+    dicts, as :attr:`Image.history` holds), or None (none, free space, unreadable).
+
+    Examples
+    --------
+    >>> medium_of_history([{"step": "migrate", "parameters": {"medium": {
+    ...     "z_interfaces": [0.3], "eps": ["(1+0j)", "(2.5+0.0125j)"]}}}]).eps[1]
+    (2.5+0.0125j)
+    """
+    from ..physics.medium import Medium
+
+    for step in reversed(list(steps or [])):
         if isinstance(step, dict) and step.get("step") == "migrate":
             g = (step.get("parameters") or {}).get("medium")
             if not g:

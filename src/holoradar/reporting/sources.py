@@ -207,10 +207,12 @@ def _ground(req: Request, obj: Any, path: Path | None) -> Ground:
 
     n = req.names
     medium, how = req.medium, f"given as {n['medium']}"
-    if medium is None and isinstance(obj, Image) and path is not None:
-        from ..io.inputs import history_medium
+    if medium is None and isinstance(obj, Image):
+        from ..io.inputs import history_medium, medium_of_history
 
-        medium = history_medium(path)
+        # A file's history, or the one an image read from a file carries in memory.
+        medium = (history_medium(path) if path is not None else
+                  medium_of_history(getattr(obj, "history", None)))
         how = "the image's history: the ground it was imaged through"
     if medium is None:
         how = "none: free space (ranges from the array, no depths)"
