@@ -351,6 +351,13 @@ class PointResponse:
             return a[:, None] * np.abs(self.h) * np.exp(1j * np.angle(g))
         return a[:, None] * g
 
+    def unmodelled_energy(self, eps: float, z: float, xy: Any, g: np.ndarray,
+                          a: np.ndarray) -> float:
+        """Energy of what the model knowingly leaves out at a fit (``g`` the response,
+        ``a`` its amplitudes): none for a point (a small scatterer's second bounce off
+        the surface is ``(k a)^3 / (k d)`` of its own field: negligible)."""
+        return 0.0
+
     def residual(self, eps: float, z: float, xy: Any, *, phase: bool | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Residual ``h - model``, the response ``g`` and the amplitudes ``a``."""

@@ -137,6 +137,25 @@ class SphereResponse(PointResponse):
         p = sphere_dipoles(E0, d_i, d_s, x)
         return np.einsum("fni,fni->fn", v, p)
 
+    def unmodelled_energy(self, eps: float, z: float, xy: Any, g: np.ndarray,
+                          a: np.ndarray) -> float:
+        """The sphere's second bounce off the interface above it, left out of the model:
+        its field back at the sphere is ``|V| |S1(pi)| / (|k_g| 2 d)`` of the incident
+        one (the echo sent up, ``S1(pi) / (k_g r)`` at ``r = 2 d`` by way of the surface
+        ``d`` above the centre, reflected with the normal-incidence ``V`` of that
+        interface) and the sphere scatters it again much as the first time: an error of
+        that share of the fitted field at each frequency, whose energy this returns."""
+        medium = self.make_medium(float(eps))
+        region = int(medium.region_of(float(z)))
+        above = medium.z_interfaces[region - 1]
+        n_in, n_up = np.sqrt(complex(medium.eps[region])), np.sqrt(complex(medium.eps[region - 1]))
+        V = abs((n_in - n_up) / (n_in + n_up))
+        k_g = self.ks * n_in
+        share = V * np.abs(sphere_backscatter(k_g * self.radius)) * np.abs(
+            k_g * self.radius) ** 3 / (np.abs(k_g) * 2 * (float(z) - above))
+        fitted = np.sum(np.abs(self.model(g, a)) ** 2, axis=1)
+        return float(np.sum(share**2 * fitted))
+
     def _incident_direction(self, medium: Medium, xy: Any, z: float) -> np.ndarray:
         """The incident ray's unit direction at the sphere (into the ground)."""
         n = np.sqrt(float(complex(medium.eps[int(medium.region_of(float(z)))]).real))

@@ -45,8 +45,10 @@ def fit_statistics(search: Search, eps: float, z: float, xy: np.ndarray) -> dict
         ``s2`` the residual's variance per real component, ``detection`` the matched
         filter's output over the noise level and ``threshold`` the level noise alone
         exceeds with chance 1e-3 over all the trials, ``phi`` the sandwich factor
-        (>= 1), ``residual_scale`` (2 for a phase-only fit, else 1) and
-        ``model_error`` the energy of the residual's smooth part.
+        (>= 1), ``residual_scale`` (2 for a phase-only fit, else 1),
+        ``model_error`` the energy of the residual's smooth part and ``unmodelled``
+        the energy of what the model knowingly leaves out (a sphere's second bounce
+        off the surface; 0 for a point or a line).
     """
     pr = search.pr
     n_amp = 1 if pr.coherent else pr.h.shape[0]
@@ -72,7 +74,8 @@ def fit_statistics(search: Search, eps: float, z: float, xy: np.ndarray) -> dict
     phi = _sandwich(search, eps, z, xy, g, a, r, s2)
     return dict(s2=s2, detection=float(detection), threshold=threshold,
                 phi=max(1.0, phi), residual_scale=2.0 if pr.phase_only else 1.0,
-                model_error=smooth_residual_energy(r.reshape(search.hologram.data.shape)))
+                model_error=smooth_residual_energy(r.reshape(search.hologram.data.shape)),
+                unmodelled=float(pr.unmodelled_energy(eps, z, xy, g, a)))
 
 
 def no_object_reason(stats: dict[str, float]) -> str:

@@ -43,7 +43,7 @@ def focus_drop(stats: dict[str, float], q: float, energy: float) -> float:
     ----------
     stats : dict
         :func:`~.fit_statistics.fit_statistics` at the optimum: ``s2``, ``phi``,
-        ``model_error`` and ``residual_scale``.
+        ``model_error``, ``unmodelled`` and ``residual_scale``.
     q : float
         The normal quantile of the confidence (:func:`quantile`).
     energy : float
@@ -52,14 +52,16 @@ def focus_drop(stats: dict[str, float], q: float, energy: float) -> float:
     Returns
     -------
     float
-        ``(q s sqrt(phi) + sqrt(E_err))^2 / (residual_scale ||h||^2)``.
+        ``(q s sqrt(phi) + sqrt(E_err) + sqrt(E_out))^2 / (residual_scale ||h||^2)``.
     """
     # The statistical part (noise, q s sqrt(phi)) and a bound on the bias a smooth model
     # error of energy E_err can cause, were it aligned with the change of eps' (profile
     # residual rises as ||d||^2 delta^2, the bias is at most sqrt(E_err)/||d||): the
-    # deviations add, so their square roots do.
-    return (q * np.sqrt(stats["s2"] * stats["phi"]) + np.sqrt(stats["model_error"])) ** 2 \
-        / (stats["residual_scale"] * energy)
+    # deviations add, so their square roots do. E_out: what the model knowingly leaves
+    # out, bounded the same way; the residual does not show the part of a model error
+    # that lies along the change of eps' (the fit absorbs it), so it is added here.
+    return (q * np.sqrt(stats["s2"] * stats["phi"]) + np.sqrt(stats["model_error"])
+            + np.sqrt(stats.get("unmodelled", 0.0))) ** 2 / (stats["residual_scale"] * energy)
 
 
 def crossing(search: Search, e_hat: float, level: float, side: int) -> float | None:
