@@ -186,10 +186,11 @@ def test_glare_suppression_reports_the_apis_numbers(rod, rod_page, tmp_path):
     assert abs(float(cells[1]) - rep.glare_removed_db) < DB_TOL
     assert abs(float(cells[2]) - rep.direct_removed_db) < DB_TOL
     assert abs(float(cells[3]) - rep.glare_suppression_db) < DB_TOL
-    # eps shown as "re ± std, im ± std j" with 3 significant digits
-    m = re.match(r"([\d.]+) ± ([\d.e-]+), ([+-][\d.e-]+) ± ([\d.e-]+)j", cells[4])
+    # eps shown as "eps' = re ± std (95 %: lo .. hi)", digits from the std
+    m = re.match(r"eps' = ([\d.]+) ± ([\d.]+) \(95 %: ([\d.]+) \.\. ([\d.]+)\)", cells[4])
     assert m, cells[4]
-    assert float(m.group(1)) == pytest.approx(rep.eps.real, rel=5e-3)
+    assert float(m.group(1)) == pytest.approx(rep.eps.real, abs=float(m.group(2)) / 10)
+    assert float(m.group(2)) == pytest.approx(rep.eps_std[0], rel=0.05)
     # The image after suppression: the rod, where the API's cleaned hologram puts it.
     x, y, d, _ = _peak(driver)
     img = hr.migrate(cleaned, 0.40, medium=sand, upsample=4, fov="full")

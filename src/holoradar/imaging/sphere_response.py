@@ -78,6 +78,10 @@ class SphereResponse(PointResponse):
         As :class:`~holoradar.imaging.point_response.PointResponse`.
     radius : float
         The sphere's radius, metres.
+    fit_radius : bool
+        Fit the radius with the position: ``xy`` is then ``(x, y, radius)`` in the
+        methods (from :attr:`shape_start`), refitted at every trial eps' within a
+        quarter of the ripple period ``pi / k_g`` of ``radius`` either side.
 
     Examples
     --------
@@ -100,9 +104,11 @@ class SphereResponse(PointResponse):
     """
 
     def __init__(self, hologram: Hologram, make_medium: Callable[[float], Medium], *,
-                 coherent: bool, radius: float, phase_only: bool = False) -> None:
+                 coherent: bool, radius: float, phase_only: bool = False,
+                 fit_radius: bool = False) -> None:
         super().__init__(hologram, make_medium, coherent=coherent, phase_only=phase_only)
         self.radius = check_sphere_radius(radius)
+        self.fit_radius = bool(fit_radius)
         if not self.vector:
             raise ValueError("target='sphere' needs the vector model: a hologram with a "
                              "polarization (the recorded field component) and a polarised "
@@ -116,6 +122,28 @@ class SphereResponse(PointResponse):
             raise ValueError("target='sphere' needs the hologram's source as a PlaneWave, a "
                              f"PointSource or a Dipole, got {type(self.source).__name__}")
 
+    # The search's extra parameters (Search.evaluate): the radius, refitted at every eps'.
+    hold_shape = False
+    shape_names = ("the sphere's radius",)
+
+    @property
+    def shape_start(self) -> tuple[float, ...]:
+        """The extra parameters' start: the radius where it is fitted, else none."""
+        return (self.radius,) if self.fit_radius else ()
+
+    def shape_box(self, shape0: np.ndarray, eps: float, lam: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Bounds and scale of the radius in a fit at ``eps`` (``lam`` the free-space
+        wavelength): a quarter of the focus's ripple period ``pi / k_g`` either side
+        (the next ripple is another fit)."""
+        half = np.pi / (4 * 2 * np.pi / lam * np.sqrt(eps))
+        a0 = float(shape0[0])
+        return (np.array([max(a0 - half, 0.2 * a0)]), np.array([a0 + half]),
+                np.array([half / 5]))
+
+    def _radius(self, xy: Any) -> float:
+        return float(xy[2]) if len(xy) > 2 else self.radius
+
     def _vector_response(self, eps: float, z: float, xy: Any, pos: np.ndarray,
                          window: Any) -> np.ndarray:
         """``u . G(e <- r) p_n`` at the elements, (nf, N): the point's with the sphere's
@@ -126,7 +154,7 @@ class SphereResponse(PointResponse):
         medium = w.medium
         region = int(medium.region_of(float(z)))
         n_c = np.sqrt(complex(medium.eps[region]))
-        x = self.ks * n_c * self.radius          # size parameter per frequency
+        x = self.ks * n_c * self._radius(xy)     # size parameter per frequency
         if self.monostatic:
             # Back to the element along the ray it came by: theta = pi for every
             # element, the polarisation kept: the point's v . v times i S1(pi) / x^3.
@@ -151,8 +179,9 @@ class SphereResponse(PointResponse):
         n_in, n_up = np.sqrt(complex(medium.eps[region])), np.sqrt(complex(medium.eps[region - 1]))
         V = abs((n_in - n_up) / (n_in + n_up))
         k_g = self.ks * n_in
-        share = V * np.abs(sphere_backscatter(k_g * self.radius)) * np.abs(
-            k_g * self.radius) ** 3 / (np.abs(k_g) * 2 * (float(z) - above))
+        a_s = self._radius(xy)
+        share = V * np.abs(sphere_backscatter(k_g * a_s)) * np.abs(k_g * a_s) ** 3 / (
+            np.abs(k_g) * 2 * (float(z) - above))
         fitted = np.sum(np.abs(self.model(g, a)) ** 2, axis=1)
         return float(np.sum(share**2 * fitted))
 

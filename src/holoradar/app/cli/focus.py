@@ -54,14 +54,14 @@ def _pair(text: str, name: str, form: str = "MIN,MAX") -> tuple[float, float]:
                                       "arrays whose element amplitudes are not calibrated).")
 @click.option("--target", type=click.Choice(["point", "line", "sphere"]), default="point",
               show_default=True,
-              help="The object fitted: a compact one, a horizontal bar or pipe, or a "
-                   "conducting sphere of --sphere-radius (line and sphere need a "
-                   "polarised hologram and source).")
+              help="The object fitted: a compact one (a point, or a conducting sphere where "
+                   "its size shows), a horizontal bar or pipe, or a conducting sphere (line "
+                   "and sphere need a polarised hologram and source).")
 @click.option("--line-radius", default=0.006, show_default=True,
               type=click.FloatRange(0, min_open=True), metavar="M",
               help="The bar's radius for --target line, m.")
 @click.option("--sphere-radius", default=None, type=click.FloatRange(0, min_open=True),
-              metavar="M", help="The sphere's radius for --target sphere (required there), m.")
+              metavar="M", help="The sphere's radius for --target sphere, m (default: fitted).")
 @click.option("--confidence", default=0.95, show_default=True,
               type=click.FloatRange(0, 1, min_open=True, max_open=True))
 @click.option("--plot", "plot_file", default=None,
@@ -85,10 +85,9 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
     from ...imaging.autofocus import autofocus as run
     from ...io.output import check_output
 
-    if (target == "sphere") != (sphere_radius is not None):
-        raise click.BadParameter("--target sphere needs --sphere-radius (the sphere's radius in "
-                                 "metres), and --sphere-radius needs --target sphere",
-                                 param_hint="--sphere-radius")
+    if sphere_radius is not None and target != "sphere":
+        raise click.BadParameter("--sphere-radius needs --target sphere (without it a "
+                                 "sphere's radius is fitted)", param_hint="--sphere-radius")
     eps_pair = _pair(eps_range, "--eps-range")
     depth_pair = None if depth_range is None else _pair(depth_range, "--depth-range")
     at = None if position is None else _pair(position, "--at", "X,Y")
@@ -124,7 +123,8 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
               target=target, line_radius=line_radius, sphere_radius=sphere_radius,
               progress=report.progress)
     files = []
-    lines = [str(res), *([res.crb_note] if res.crb_note else [])]
+    lines = [str(res), *([res.model_note] if res.model_note else []),
+             *([res.crb_note] if res.crb_note else [])]
     if plot_file is not None:
         if res.eps_grid.size > 1:
             _plot(res, plot_file, hologram_file.name)
@@ -143,6 +143,7 @@ def autofocus(hologram_file: Path, medium_spec: dict[str, Any], eps_range: str,
         "eps_glare": res.eps_glare, "eps_glare_std": res.eps_glare_std,
         "handle": res.handle, "focus_fraction": res.focus_fraction, "target": target,
         "line_azimuth_deg": res.line_azimuth_deg, "line_length_m": res.line_length,
+        "sphere_radius_m": res.sphere_radius, "model_note": res.model_note,
         "evaluations": res.evaluations, "seconds": res.seconds, "files": files,
     }
     if res.position is not None:

@@ -28,6 +28,7 @@ from .checks import (
 from .glare_estimate import glare_input
 from .result import AutofocusResult
 from .search import Search
+from .sphere_fit import sphere_instead
 from .steps import COARSE, NoHandleError, Run, estimate
 
 __all__ = ["autofocus"]
@@ -164,7 +165,14 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     handle = ("one frequency: the wave front's shape" if hologram.nf == 1 else
               "several frequencies: the wave front's shape and the delay" if coherent else
               "several frequencies without the illumination: the wave front's shape only")
-    pr = _response(hologram, make, coherent, fit, target, line_radius, sphere_radius)
+    # A sphere of unknown radius: located and fitted as a point first, its radius then
+    # scanned at the point's eps' (sphere_fit.py).
+    fit_radius = target == "sphere" and sphere_radius is None
+    first = "point" if fit_radius else target
+    if fit_radius:
+        _response(hologram, make, coherent, fit, "sphere", line_radius, 0.01)  # applies?
+    pr = _response(hologram, make, coherent, fit, first, line_radius,
+                   None if fit_radius else sphere_radius)
     search = Search(pr, make, lo, hi, hologram, _progress_bar(target, progress))
     run = Run(search, make, lo, hi, z0=make(lo).z_interfaces[0], confidence=confidence,
               glare=glare_est, t_start=t_start,
@@ -172,9 +180,16 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
                         eps_glare=None if glare_est is None else glare_est[0],
                         eps_glare_std=None if glare_est is None else glare_est[1]))
     try:
-        fields = estimate(run, depth_range, position, target)
+        fields = estimate(run, depth_range, position, first)
     except NoHandleError as stop:
         fields = stop.fields
+    if first == "sphere" and fields.get("position") is not None:
+        fields["sphere_radius"] = pr.radius
+    if first == "point" and fields.get("determinable") and fields.get("eps_focus") is not None:
+        as_sphere = sphere_instead(run, hologram, coherent, fit, depth_range, fields,
+                                   forced=fit_radius)
+        if as_sphere is not None:
+            run, fields = as_sphere
     return run.finish(**fields)
 
 

@@ -147,10 +147,11 @@ def jacobian(search: Search, eps: float, z: float, xy: np.ndarray, *,
         return pr.model(pr.response(e, zz, p), a).ravel()
 
     cols = [(model(eps + de, z, xy) - model(eps - de, z, xy)) / (2 * de)]
-    names = ["x", "y", "the line's azimuth", "the line's length"][:len(xy)]
-    # A line's azimuth: its ends move by dp.
-    turn = dp / (xy[3] / 2) if len(xy) > 3 else 0.0
-    for i, step in enumerate([dp, dp, turn, dp][:len(xy)]):
+    names = ["x", "y", *getattr(pr, "shape_names", ("the line's azimuth",
+                                                     "the line's length"))][:len(xy)]
+    # A line's azimuth: its ends move by dp; a sphere's radius by dp.
+    steps = [dp, dp, dp / (xy[3] / 2), dp] if len(xy) > 3 else [dp] * len(xy)
+    for i, step in enumerate(steps):
         dv = np.zeros(len(xy))
         dv[i] = step
         cols.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * step))

@@ -68,6 +68,12 @@ class AutofocusResult:
     seconds : float
     medium : Medium or None
         The ground model at the estimate.
+    sphere_radius : float or None
+        The radius of the conducting sphere fitted (``target="sphere"``, or a point fit
+        that a sphere explained far better), metres; None for a point or a line.
+    model_note : str
+        Why the object was fitted as a sphere when a point was asked for (the
+        share of the energy each left unexplained); ``""`` otherwise.
 
     Examples
     --------
@@ -110,6 +116,8 @@ class AutofocusResult:
     line_length: float | None = None
     eps_crb: float | None = None
     crb_note: str = ""
+    sphere_radius: float | None = None
+    model_note: str = ""
 
     @property
     def std(self) -> float | None:
@@ -130,6 +138,8 @@ class AutofocusResult:
             text += f"; Cramér-Rao bound's sigma {self.eps_crb:.2g}"
         text += ")"
         if self.position is not None and self.depth is not None:
-            text += (f"; object at range {self.position[2]:.4g} m, {self.depth:.4g} m below the "
-                     "surface")
+            what = ("object" if self.sphere_radius is None else
+                    f"a conducting sphere of radius {1e3 * self.sphere_radius:.1f} mm")
+            text += (f"; {what} at range {self.position[2]:.4g} m, {self.depth:.4g} m below "
+                     "the surface")
         return f"{text} ({self.handle if self.eps_focus is not None else self.reason})"

@@ -112,7 +112,8 @@ class Search:
         else:
             _, iy, ix = np.unravel_index(int(np.argmax(a)), a.shape)
         self.z0 = z0
-        self.xy = np.array([img.x[ix], img.y[iy]], float)
+        self.xy = np.array([img.x[ix], img.y[iy], *getattr(self.pr, "shape_start", ())],
+                           float)
         if getattr(self.pr, "max_length", None) is not None:
             self.xy = line_from_image(a, img.x, img.y, iy, ix, self.pr.max_length, lam_m)
         self.pr.xy_hint = self.xy[:2]
@@ -200,12 +201,13 @@ class Search:
         lam_m = self.lam / np.sqrt(eps)
         xy0, z_start = self._start(eps, floor, lam_m)
         shape0 = np.asarray(xy0[2:], float)          # a line's azimuth and length
-        if shape0.size and self.best and not refine_shape:
+        if shape0.size and self.best and not refine_shape and getattr(pr, "hold_shape", True):
             # A line's shape hardly depends on eps': fitted once (the first trial, and
             # at the optimum), held during the sweep.
             return self._evaluate_fixed_shape(eps, floor, xy0, z_start, lam_m)
         p0 = np.array([xy0[0], xy0[1], z_start, *shape0])
-        if shape0.size and self.scan_length:
+        line = getattr(pr, "max_length", None) is not None
+        if line and self.scan_length:
             p0 = self._length_scan(eps, p0, lam_m)
 
         def resid(p: np.ndarray) -> np.ndarray:
@@ -214,7 +216,11 @@ class Search:
 
         lo_b, hi_b = self._box(p0, eps, floor, lam_m)
         scale = np.full(3, self.lam / 10)
-        if shape0.size:  # azimuth within 20 degrees, length within a factor 2 of the start
+        if shape0.size and not line:   # another model's own (a sphere's radius)
+            lo_s, hi_s, sc = pr.shape_box(shape0, eps, self.lam)
+            lo_b, hi_b, scale = np.r_[lo_b, lo_s], np.r_[hi_b, hi_s], np.r_[scale, sc]
+            p0[3:] = np.clip(p0[3:], lo_b[3:] + 1e-12, hi_b[3:] - 1e-12)
+        elif shape0.size:  # azimuth within 20 degrees, length within a factor 2 of the start
             L0 = float(shape0[1])
             lo_b = np.r_[lo_b, shape0[0] - 0.35, max(lam_m, 0.5 * L0)]
             hi_b = np.r_[hi_b, shape0[0] + 0.35, max(min(pr.max_length, 2 * L0), lam_m * 1.01)]

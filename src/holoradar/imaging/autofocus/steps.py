@@ -204,6 +204,8 @@ def _optimum(run: Run) -> tuple[float, float, dict[str, float], dict[str, Any]]:
     pos = (float(xy_hat[0]), float(xy_hat[1]), float(z_hat))
     line = {} if len(xy_hat) < 4 else dict(
         line_azimuth_deg=float(np.degrees(xy_hat[2]) % 180.0), line_length=float(xy_hat[3]))
+    if len(xy_hat) == 3:   # a sphere's fitted radius
+        line = dict(sphere_radius=float(xy_hat[2]))
     common = dict(position=pos, depth=float(z_hat - run.z0), focus_fraction=F_max, **line,
                   detection=stats["detection"], detection_threshold=stats["threshold"],
                   noise_inflation=stats["phi"])
