@@ -34,7 +34,7 @@ from ..physics.green import legendre
 from ..physics.line_green import line_field
 from ..physics.medium import Medium
 from ..physics.sources import PlaneWave, PointSource
-from .point_response import PointResponse, _Grid
+from .point_response import PointResponse, _Grid, require_vector_flat
 
 _sparse = lazy_module("scipy.sparse")
 
@@ -173,14 +173,7 @@ def _line_setup(pr: Any, hologram: Hologram, radius: float, eps_line: Any) -> No
 
 def _check_line_model(pr: PointResponse, hologram: Hologram) -> None:
     """What both line models need: the vector model, a separate source, a flat grid."""
-    if not pr.vector or pr.monostatic:
-        raise ValueError("target='line' needs the vector model with a separate source: a "
-                         "hologram with a polarization (the recorded field component) "
-                         "and a polarised source (a Dipole, or a source given a "
-                         "polarization)")
-    if not (pr.flat and hologram.pose.is_identity):
-        raise ValueError("target='line' needs an untilted aperture (a tilted one is not "
-                         "modelled for lines)")
+    require_vector_flat(pr, hologram, "line", transceiver=False)
 
 
 def polarizabilities(ks: np.ndarray, eps_ground: complex, radius: float,

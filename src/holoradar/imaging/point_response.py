@@ -366,6 +366,22 @@ class PointResponse:
         return self.h - self.model(g, a, phase=phase), g, a
 
 
+def require_vector_flat(pr: PointResponse, hologram: Hologram, target: str, *,
+                        transceiver: bool) -> None:
+    """What the line and sphere models need: the vector model (with a separate source,
+    unless ``transceiver``) on an untilted grid; a ValueError naming ``target`` else."""
+    if not pr.vector or (pr.monostatic and not transceiver):
+        raise ValueError(
+            f"target={target!r} needs the vector model"
+            f"{'' if transceiver else ' with a separate source'}: a hologram with a "
+            "polarization (the recorded field component) and a polarised source (a Dipole, "
+            "or a source given a polarization)" + (", or a scanned transceiver"
+                                                    if transceiver else ""))
+    if not (pr.flat and hologram.pose.is_identity):
+        raise ValueError(f"target={target!r} needs an untilted aperture (a tilted one is not "
+                         f"modelled for {target}s)")
+
+
 class _Window:
     def __init__(self, zs: np.ndarray, G: list, E: list | None, medium: Medium) -> None:
         self.zs, self.G, self.E, self.medium = zs, G, E, medium

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import as_real
 from ..data.hologram import Hologram
 from ..physics.dipole import Dipole
 from ..physics.dyadic import dyadic_times
@@ -42,7 +43,7 @@ from ..physics.line_green import RayFan
 from ..physics.medium import Medium
 from ..physics.mie import pec_sphere_amplitudes
 from ..physics.sources import PlaneWave, PointSource
-from .point_response import PointResponse
+from .point_response import PointResponse, require_vector_flat
 
 __all__ = ["SphereResponse", "check_sphere_radius", "sphere_backscatter", "sphere_dipoles"]
 
@@ -55,14 +56,9 @@ def check_sphere_radius(radius: Any) -> float:
     >>> check_sphere_radius(0.015)
     0.015
     """
-    try:
-        r = float(radius) if np.isscalar(radius) else np.nan
-    except (TypeError, ValueError):
-        r = np.nan
-    if not (np.isfinite(r) and r > 0):
-        raise ValueError(f"sphere_radius must be the sphere's radius in metres (> 0), got "
-                         f"{radius!r}")
-    return r
+    if isinstance(radius, str | bytes):
+        raise ValueError(f"sphere_radius must be the sphere's radius in metres, got {radius!r}")
+    return as_real(radius, "sphere_radius (the sphere's radius in metres)", positive=True)
 
 
 class SphereResponse(PointResponse):
@@ -109,14 +105,7 @@ class SphereResponse(PointResponse):
         super().__init__(hologram, make_medium, coherent=coherent, phase_only=phase_only)
         self.radius = check_sphere_radius(radius)
         self.fit_radius = bool(fit_radius)
-        if not self.vector:
-            raise ValueError("target='sphere' needs the vector model: a hologram with a "
-                             "polarization (the recorded field component) and a polarised "
-                             "source (a Dipole, a PlaneWave or a PointSource given one), or a "
-                             "scanned transceiver")
-        if not (self.flat and hologram.pose.is_identity):
-            raise ValueError("target='sphere' needs an untilted aperture (a tilted one is not "
-                             "modelled for spheres)")
+        require_vector_flat(self, hologram, "sphere", transceiver=True)
         if not self.monostatic and not isinstance(self.source, PlaneWave | PointSource
                                                   | Dipole):
             raise ValueError("target='sphere' needs the hologram's source as a PlaneWave, a "
