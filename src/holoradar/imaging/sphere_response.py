@@ -7,7 +7,7 @@ its strength and phase change with the scattering angle. :class:`SphereResponse`
 replaces the point model's induced dipole ``a E0`` (:mod:`holoradar.imaging.point_response`)
 by the dipole that radiates the sphere's own far field towards each element:
 
-    p_n = (i / x^3) [S2(theta_n) (E0 . e_par) e_par_n + S1(theta_n) (E0 . e_perp_n) e_perp_n]
+    p_n = (i / x) [S2(theta_n) (E0 . e_par) e_par_n + S1(theta_n) (E0 . e_perp_n) e_perp_n]
 
 ``S1, S2`` the Mie amplitudes of a perfect conductor (:mod:`holoradar.physics.mie`)
 at ``x = k_g a`` (``k_g`` the ground's wavenumber), ``theta_n`` the scattering angle
@@ -15,12 +15,23 @@ between the incident ray's direction at the sphere ``d_i`` and the ray leaving i
 for element n ``d_n`` (both refracted through the layers, Snell's law),
 ``e_perp_n = d_i x d_n / |d_i x d_n|``, ``e_par = e_perp_n x d_i`` and
 ``e_par_n = e_perp_n x d_n``. The element then records ``a (G(r <- e) u) . p_n`` as
-for a point (reciprocity). Matching the far fields of a dipole and of the sphere,
-``alpha = 4 pi i a^3 S / x^3``: the factor ``i S / x^3`` carries the sphere's
-frequency dependence, constant for a small sphere (``S1 -> -i x^3 (1 - cos theta / 2)``,
-an electric dipole and a magnetic one of half its strength), and for a large one the
-echo from its near side, ``exp(-2 i k_g a)`` at backscatter. With ``S1 = 1`` and
-``S2 = cos theta`` it is the point model exactly.
+for a point (reciprocity).
+
+Its frequency dependence. Matching the far fields of a dipole and of the sphere, the
+sphere radiates as a dipole of SI polarisability ``alpha = 4 pi eps0 a^3 i S / x^3``.
+holoradar's fields are normalised as ``G = (I + grad grad / k_m^2) exp(i k_m R)/R``,
+the physical field of a dipole moment divided by ``k^2 / (4 pi eps0)`` (its sources:
+a :class:`~holoradar.Dipole` of fixed moment), and data across a band are taken as
+calibrated to that source: a physical field ``E`` is ``k^2/(4 pi eps0) x`` the
+calibrated one, for the incident field and for the scattered one alike. The sphere's
+echo in calibrated units is then ``k^2 a^3 (i S / x^3) G E0 = a (i S / x) G E0``:
+the factor ``i S / x`` (the point model's amplitude is a constant). Small spheres
+rise as ``x^2`` (``S1 -> -i x^3 (1 - cos theta / 2)``, an electric dipole and a
+magnetic one of half its strength); large ones are flat, ``|S(pi)| / x -> 1/2``,
+the echo of the near side turning as ``exp(-2 i k_g a)``. With ``S1 = 1`` and
+``S2 = cos theta`` at one frequency it is the point model exactly. (SMUTHI's
+fields of a fixed moment, calibrated by ``1/k^2``: the sphere leaves 3e-4 of a
+9-11 GHz band unexplained at the true eps', ``i S / x^3`` 2e-2, the point 7e-3.)
 
 The sphere must lie in the far field of each element's ray (``k_g R >> x^2``) and the
 layers' interaction with the sphere (a second bounce between the sphere and the
@@ -169,8 +180,9 @@ class SphereResponse(PointResponse):
         V = abs((n_in - n_up) / (n_in + n_up))
         k_g = self.ks * n_in
         a_s = self._radius(xy)
-        share = V * np.abs(sphere_backscatter(k_g * a_s)) * np.abs(k_g * a_s) ** 3 / (
-            np.abs(k_g) * 2 * (float(z) - above))
+        back = np.array([abs(pec_sphere_amplitudes(x, np.array([np.pi]))[0][0])
+                         for x in k_g * a_s])
+        share = V * back / (np.abs(k_g) * 2 * (float(z) - above))
         fitted = np.sum(np.abs(self.model(g, a)) ** 2, axis=1)
         return float(np.sum(share**2 * fitted))
 
@@ -201,25 +213,25 @@ class SphereResponse(PointResponse):
 
 
 def sphere_backscatter(x: np.ndarray) -> np.ndarray:
-    """``i S1(pi) / x^3``: a sphere's dipole factor straight back along the incident ray
+    """``i S1(pi) / x``: a sphere's dipole factor straight back along the incident ray
     (``S1(pi) = -S2(pi)``: the polarisation kept), per size parameter ``x``.
 
     Examples
     --------
-    Small: 3/2 (the electric dipole's 1 and the magnetic one's 1/2). Large: the echo
-    from the near side, its phase falling by 2 per unit of ``x`` (a round trip ``a``
-    shorter than to the centre).
+    Small: ``3/2 x^2`` (the electric dipole's 1 and the magnetic one's 1/2). Large: 1/2
+    in modulus, the echo from the near side, its phase falling by 2 per unit of ``x``
+    (a round trip ``a`` shorter than to the centre).
 
-    >>> float(np.round(sphere_backscatter(np.array([1e-3]))[0].real, 6))
+    >>> float(np.round(sphere_backscatter(np.array([1e-3]))[0].real / 1e-6, 6))
     1.5
     """
-    return np.array([1j * pec_sphere_amplitudes(xf, np.array([np.pi]))[0][0] / xf**3
+    return np.array([1j * pec_sphere_amplitudes(xf, np.array([np.pi]))[0][0] / xf
                      for xf in np.atleast_1d(x)])
 
 
 def sphere_dipoles(E0: np.ndarray, d_i: np.ndarray, d_s: np.ndarray,
                    x: np.ndarray) -> np.ndarray:
-    """The dipoles ``(i / x^3) [S2 (E0 . e_par) e_par_n + S1 (E0 . e_perp_n) e_perp_n]``
+    """The dipoles ``(i / x) [S2 (E0 . e_par) e_par_n + S1 (E0 . e_perp_n) e_perp_n]``
     radiating a perfectly conducting sphere's far field along each ``d_s``.
 
     Parameters
@@ -240,12 +252,12 @@ def sphere_dipoles(E0: np.ndarray, d_i: np.ndarray, d_s: np.ndarray,
 
     Examples
     --------
-    A small sphere seen sideways: the electric dipole's ``E0`` less half the magnetic
-    one's (``S1 = -i x^3 (1 - cos theta / 2)``, ``S2 = -i x^3 (cos theta - 1/2)``).
+    A small sphere seen sideways, E0 across the scattering plane: ``x^2 E0``
+    (``S1 = -i x^3 (1 - cos theta / 2)``).
 
     >>> p = sphere_dipoles(np.array([[0, 1, 0]]), np.array([0, 0, 1.0]),
     ...                    np.array([[1.0, 0, 0]]), np.array([1e-3]))
-    >>> np.round(p.real, 3)
+    >>> np.round(p.real / 1e-6, 3)
     array([[[0., 1., 0.]]])
     """
     cross = np.cross(d_i[None, :], d_s)
@@ -262,7 +274,7 @@ def sphere_dipoles(E0: np.ndarray, d_i: np.ndarray, d_s: np.ndarray,
     out = np.empty((len(x), len(d_s), 3), complex)
     for f, xf in enumerate(x):
         S1, S2 = pec_sphere_amplitudes(xf, theta)
-        c = 1j / xf**3
+        c = 1j / xf
         e_par = par_i @ E0[f]
         e_perp = perp @ E0[f]
         out[f] = c * ((S2 * e_par)[:, None] * par_s + (S1 * e_perp)[:, None] * perp)

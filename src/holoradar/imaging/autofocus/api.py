@@ -13,6 +13,8 @@ import time
 from collections.abc import Callable
 from typing import Any, Literal
 
+import numpy as np
+
 from ...data.hologram import Hologram
 from ...physics.medium import Medium
 from ..point_response import PointResponse
@@ -185,8 +187,14 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         fields = stop.fields
     if first == "sphere" and fields.get("position") is not None:
         fields["sphere_radius"] = pr.radius
-    if first == "point" and fields.get("determinable") and fields.get("eps_focus") is not None:
-        as_sphere = sphere_instead(run, hologram, coherent, fit, depth_range, fields,
+    # A point found (or found but ambiguous, or at the edge of eps_range: a sphere's
+    # better fit may settle it) may turn out to be a sphere whose size shows.
+    found = fields.get("position") is not None and fields.get("detection", 0.0) >= fields.get(
+        "detection_threshold", np.inf) and bool(run.search.best)
+    if first == "point" and found:
+        best = run.search.best
+        e0 = max(best, key=lambda e: best[e][0])
+        as_sphere = sphere_instead(run, hologram, coherent, fit, depth_range, fields, e0,
                                    forced=fit_radius)
         if as_sphere is not None:
             run, fields = as_sphere

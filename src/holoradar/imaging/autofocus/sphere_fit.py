@@ -85,7 +85,9 @@ def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any, lam: float,
         radii = radii[radii > 0]
     floor = z - 0.5 * lam / np.sqrt(eps)
 
-    def best_at(a: float, start: np.ndarray) -> tuple[float, np.ndarray]:
+    def best_at(a: float, start: np.ndarray, deeper: float = 0.0) -> tuple[float, np.ndarray]:
+        """The best centre for radius ``a``: the point fit's range marks the sphere's echo,
+        which comes from its near side (the centre up to ``a`` deeper: ``deeper``)."""
         pr.radius = float(a)
 
         def resid(p: np.ndarray) -> np.ndarray:
@@ -94,13 +96,14 @@ def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any, lam: float,
 
         reach = lam / (4 * np.sqrt(eps))
         lo_b = np.array([start[0] - reach, start[1] - reach, max(start[2] - reach, floor)])
-        hi_b = np.array([start[0] + reach, start[1] + reach, start[2] + reach])
-        p = _least_squares(resid, np.clip(start, lo_b + 1e-9, hi_b - 1e-9), lo_b, hi_b,
+        hi_b = np.array([start[0] + reach, start[1] + reach, start[2] + deeper + reach])
+        p0 = start + np.array([0.0, 0.0, deeper / 2])
+        p = _least_squares(resid, np.clip(p0, lo_b + 1e-9, hi_b - 1e-9), lo_b, hi_b,
                            np.full(3, lam / 10), 1e-8, 40)
         return pr.focus(eps, p[2], p[:2]), p
 
     start = np.array([xy[0], xy[1], z], float)
-    fits = [best_at(a, start) for a in radii]
+    fits = [best_at(a, start, a) for a in radii]
     i = int(np.argmax([f for f, _ in fits]))
     lo_a = radii[max(i - 1, 0)]
     hi_a = radii[min(i + 1, radii.size - 1)]
@@ -135,14 +138,16 @@ def shortest_wavelength(hologram: Hologram) -> float:
 
 
 def sphere_instead(run: Run, hologram: Hologram, coherent: bool, fit: str, depth_range: Any,
-                   fields: dict[str, Any], *, forced: bool) -> tuple[Run, dict[str, Any]] | None:
+                   fields: dict[str, Any], eps: float, *,
+                   forced: bool) -> tuple[Run, dict[str, Any]] | None:
     """The sphere's search after a point's: its radius scanned at the point's estimate
     (the ripple's every period: a fit alone stops on the nearest), then eps' searched
     with the radius refitted at every trial (the interval profiles it). ``forced``: the
     sphere was asked for (a radius to fit); else only where :func:`worth_a_sphere` and
     :func:`sphere_gain` say so. Returns the sphere's run and result fields, or None to
-    keep the point's."""
-    e = float(fields["eps_focus"])
+    keep the point's. ``eps``: the point's best eps' (its estimate, or the best of
+    rivals it could not tell apart)."""
+    e = float(eps)
     x, y, z = fields["position"]
     point = run.search
     lam = shortest_wavelength(hologram)
