@@ -21,14 +21,11 @@ in 1/m) and, for the dipole, eps0 = mu0 = 1 (see the JSON's source.normalisation
 import json
 import os
 import platform
-import sys
 import time
 
 import numpy as np
 import scipy
-
 import smuthi
-import smuthi.fields as flds
 import smuthi.fields.transformations as trf
 import smuthi.initial_field as init
 import smuthi.layers as lay
