@@ -28,6 +28,7 @@ loads it ahead of the first call.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -38,7 +39,7 @@ from .. import _threads
 from .._lazy import lazy_module
 from .._threads import fft_workers, pool
 from ..physics.medium import Medium
-from ..physics.propagation import TRANSFER_CACHE
+from ..physics.propagation import _TransferCache, register_cache
 from ..physics.spectra import interpolate
 from . import kspace
 
@@ -55,6 +56,23 @@ _BUFFER_MIN = 1 << 24  # or 16 MiB
 #: below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128 (by
 #: dtype character; the forward map drops the same terms).
 TINY = {"F": 1e-9, "D": kspace._TINY}
+
+
+def _plan_budget() -> int:
+    """Bytes of column plans kept between calls: a sixteenth of the machine's memory,
+    at least 256 MiB (a 64-frequency band on a 512 x 512 grid needs 326 MiB; rebuilt at
+    every call it cost 1.1 s of 1.9)."""
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        memory = 0
+    return max(256 * 2**20, int(memory) // 16)
+
+
+#: The compiled sum's plans (one per geometry, band and planes), least recently used
+#: out beyond :func:`_plan_budget`; :func:`~holoradar.physics.propagation.clear_transfer_cache`
+#: frees them.
+PLAN_CACHE = register_cache(_TransferCache(_plan_budget()))
 
 
 def available() -> bool:
@@ -250,7 +268,7 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
     key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
            float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
            pol, direct, work.str, tuple(weights != 0))
-    plan = TRANSFER_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
+    plan = PLAN_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
     out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
     run = _kernel()

@@ -291,10 +291,20 @@ class _TransferCache:
 #: propagator and migration backend (least recently used out beyond 256 MiB).
 TRANSFER_CACHE = _TransferCache(256 * 2**20)
 
+_CACHES = [TRANSFER_CACHE]
+
+
+def register_cache(cache: _TransferCache) -> _TransferCache:
+    """Have :func:`clear_transfer_cache` free ``cache`` too (a module's own plans)."""
+    _CACHES.append(cache)
+    return cache
+
 
 def clear_transfer_cache() -> None:
-    """Free the cached transfer functions (at most 256 MiB are kept)."""
-    TRANSFER_CACHE.clear()
+    """Free the cached transfer functions (at most 256 MiB are kept) and the wideband
+    sum's plans (:data:`holoradar.imaging.columns.PLAN_CACHE`)."""
+    for cache in _CACHES:
+        cache.clear()
 
 
 def transfer_cache_bytes() -> int:
