@@ -102,8 +102,10 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         Confidence of the interval, default 0.95.
     target : {"point", "line", "sphere"}
         The object: ``"point"`` (default), a compact scatterer (an isotropic induced
-        dipole in the vector model); ``"sphere"``, a perfectly conducting sphere of
-        radius ``sphere_radius`` centred at the fitted position, its Mie far field
+        dipole in the vector model), fitted as a conducting sphere instead where the
+        point leaves a smooth residual that a sphere of fitted radius at least halves
+        (``result.sphere_radius``, ``result.model_note``); ``"sphere"``, a perfectly
+        conducting sphere centred at the fitted position, its Mie far field
         towards each element (:mod:`holoradar.imaging.sphere_response`: where
         ``k a`` in the ground is 1 or more the point model misreads the sphere's
         echo, which comes from the side facing the rays' bisector; on a T-matrix
@@ -124,7 +126,10 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         bar; a perfect conductor). A thick bar echoes from its near side: a wrong
         radius biases eps' by about ``(a_true - a)/depth``.
     sphere_radius : float, optional
-        The sphere's radius in metres, for ``target="sphere"`` (and only for it).
+        The sphere's radius in metres, for ``target="sphere"`` (and only for it);
+        default: fitted (scanned at the point fit's eps', then refitted at every trial
+        eps'). At one frequency the radius trades with eps' almost perfectly: a known
+        radius narrows the interval many times.
     progress : bool
         Show a progress bar over all the work: locating the object, then every trial
         permittivity (its total grows when the refinement needs more).
@@ -171,8 +176,8 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
     # scanned at the point's eps' (sphere_fit.py).
     fit_radius = target == "sphere" and sphere_radius is None
     first = "point" if fit_radius else target
-    if fit_radius:
-        _response(hologram, make, coherent, fit, "sphere", line_radius, 0.01)  # applies?
+    if fit_radius:   # the sphere model must apply to these data: say so now if not
+        _response(hologram, make, coherent, fit, "sphere", line_radius, 0.01)
     pr = _response(hologram, make, coherent, fit, first, line_radius,
                    None if fit_radius else sphere_radius)
     search = Search(pr, make, lo, hi, hologram, _progress_bar(target, progress))

@@ -104,7 +104,7 @@ def check_target(target: Any) -> None:
     """``target`` is ``"point"``, ``"line"`` or ``"sphere"``."""
     if target not in ("point", "line", "sphere"):
         raise ValueError(f"target must be 'point' (a compact object), 'line' (rebar, pipe) or "
-                         f"'sphere' (a conducting ball of known radius), got {target!r}")
+                         f"'sphere' (a conducting ball), got {target!r}")
 
 
 def check_line_radius(line_radius: Any) -> float:

@@ -54,8 +54,8 @@ def sphere_model(hologram: Hologram, make: Callable[[float], Medium], coherent: 
         return None
 
 
-def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any, lam: float,
-                around: float | None = None) -> tuple[float, float, float, np.ndarray]:
+def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any,
+                lam: float) -> tuple[float, float, float, np.ndarray]:
     """The radius (metres) that focuses best at ``eps``, with its focus fraction, range
     and lateral position; ``pr.radius`` is left at it.
 
@@ -69,9 +69,6 @@ def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any, lam: float,
         The start of its lateral position, metres.
     lam : float
         The shortest free-space wavelength, metres.
-    around : float, optional
-        Scan only three steps either side of this radius (a radius found at a nearby
-        eps'), metres.
 
     Returns
     -------
@@ -80,9 +77,6 @@ def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any, lam: float,
     k_g = 2 * np.pi / lam * np.sqrt(eps)
     step = np.pi / (_STEPS_PER_WRAP * k_g)
     radii = np.arange(_KA[0] / k_g, _KA[1] / k_g + step / 2, step)
-    if around is not None:
-        radii = float(around) + step * np.arange(-3, 4)
-        radii = radii[radii > 0]
     floor = z - 0.5 * lam / np.sqrt(eps)
 
     def best_at(a: float, start: np.ndarray, deeper: float = 0.0) -> tuple[float, np.ndarray]:
