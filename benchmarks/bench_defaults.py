@@ -13,7 +13,8 @@ run, ratios only (the machine is shared):
 * ``makers``: a device maker's 40-line NumPy Stolt (``bench_fft_limit.makers_stolt``);
 * ``cold``: the default's first call in a fresh process (``import holoradar`` and the
   data made before the clock starts), and the whole of ``holoradar image`` on a file
-  in a fresh process (start, import, read, image, write).
+  in a fresh process (start, import, read, image, write) beside the maker's whole
+  script in a fresh Python (import NumPy, ``np.load``, their Stolt, ``np.save``).
 
 Writes ``benchmarks/results_defaults.json``. Run: ``python benchmarks/bench_defaults.py``;
 ``--large``: 64 frequencies x 256 x 256 onto 256 planes (``results_defaults_large.json``).
@@ -35,6 +36,22 @@ HERE = Path(__file__).parent
 NF, NY, NX, NZ, ZMAX = 11, 187, 144, 110, 0.18
 if "--large" in sys.argv:
     NF, NY, NX, NZ = 64, 256, 256, 256
+
+
+# A maker's whole script in a fresh Python: import NumPy, read the data, their Stolt,
+# save the volume (the Stolt of bench_fft_limit, which imports NumPy alone).
+MAKERS_SCRIPT = """
+import sys
+import numpy as np
+from types import SimpleNamespace
+sys.path.insert(0, sys.argv[1])
+from bench_fft_limit import makers_stolt
+d = np.load(sys.argv[2])
+x, y, f = d["x"], d["y"], d["f"]
+h = SimpleNamespace(data=d["data"], pitch=(x[1] - x[0], y[1] - y[0]),
+                    wavenumbers=2 * np.pi * f / 299792458.0)
+np.save(sys.argv[3], makers_stolt(h, np.linspace(0.0, float(sys.argv[4]), int(sys.argv[5]))))
+"""
 
 
 def hologram(dtype=np.complex128):
@@ -98,24 +115,33 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as d:
         src = Path(d) / "h.nc"
         hr.save(h, src)
-        ends = []
+        raw = Path(d) / "h.npz"
+        np.savez(raw, data=h.data, x=h.x, y=h.y, f=h.frequencies)
+        ends, makers_ends = [], []
         for i in range(3):
             t = time.perf_counter()
             subprocess.run([sys.executable, "-m", "holoradar", "image", str(src), "--z",
                             f"0:{ZMAX}:{ZMAX / (NZ - 1)}", "--upsample", "1", "--no-png",
                             "-q", "-o", str(Path(d) / f"i{i}.nc")], check=True)
             ends.append(time.perf_counter() - t)
+            t = time.perf_counter()
+            subprocess.run([sys.executable, "-c", MAKERS_SCRIPT, str(HERE), str(raw),
+                            str(Path(d) / f"m{i}.npy"), str(ZMAX), str(NZ)], check=True)
+            makers_ends.append(time.perf_counter() - t)
     out = {
         "case": f"{NF} frequencies x {NY} x {NX} at 3 mm onto {NZ} planes, complex128 data",
         "warm_s": warm,
         "cold_first_call_s": statistics.median(cold),
         "cli_end_to_end_s": statistics.median(ends),
+        "makers_end_to_end_s": statistics.median(makers_ends),
         "ratios": {
             "default_over_floor": warm["default"] / warm["floor"],
             "makers_over_default": warm["makers"] / warm["default"],
             "double_over_default": warm["double"] / warm["default"],
             "default_over_unpadded": warm["default"] / warm["unpadded"],
             "cold_over_floor": statistics.median(cold) / warm["floor"],
+            "cli_over_makers_end_to_end": statistics.median(ends) / statistics.median(
+                makers_ends),
         },
     }
     name = "results_defaults_large.json" if large else "results_defaults.json"
