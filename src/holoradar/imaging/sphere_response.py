@@ -157,7 +157,7 @@ class SphereResponse(PointResponse):
         x = self.ks * n_c * self._radius(xy)     # size parameter per frequency
         if self.monostatic:
             # Back to the element along the ray it came by: theta = pi for every
-            # element, the polarisation kept: the point's v . v times i S1(pi) / x^3.
+            # element, the polarisation kept: the point's v . v times i S1(pi) / x.
             return np.einsum("fni,fni->fn", v, v) * sphere_backscatter(x)[:, None]
         E0 = self._incident_vector(medium, pos, xy, z, w)                  # (nf, 3)
         d_i = self._incident_direction(medium, xy, z)                      # (3,)
