@@ -233,7 +233,9 @@ def test_survey_report_is_detects_in_survey_coordinates(tmp_path):
     assert s["sources"][0]["kind"] == "survey"
     assert_table_is_detects(page.tables[0], det)
     rows = page.tables[0]
-    assert [r["frame"][1] for r in rows] == list(det["frame"])
+    # The report names every frame an object was seen in (detect's "frames", ";"-joined
+    # there), not only the frame its numbers came from ("frame").
+    assert [r["frame"][1] for r in rows] == [f.replace(";", ", ") for f in det["frames"]]
     cell = hr.theory.lateral_resolution(hr.C0 / 9.9e9, SAND.apparent_distance(0.42), 0.2)
     # the point, once, where it lies in the world (within a quarter cell: detect's own
     # survey test's bound, the window fit's bias well inside it)

@@ -291,10 +291,17 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
     import dask
     from distributed import Client, LocalCluster
 
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": _spawn_environ()}):
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.CRITICAL,
-                               preload=["holoradar.survey.warm"], env=WORKER_ENV)
+    # The workers inherit this process's environment at spawn: where an earlier Dask
+    # nanny in it left MALLOC_TRIM_THRESHOLD_ in os.environ, leave it out for them too.
+    inherited = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    try:
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": _spawn_environ()}):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=":0", silence_logs=logging.CRITICAL,
+                                   preload=["holoradar.survey.warm"], env=WORKER_ENV)
+    finally:
+        if inherited is not None:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = inherited
     try:
         client = Client(cluster, set_as_default=False)
     except BaseException:
