@@ -192,10 +192,11 @@ def autofocus(hologram: Hologram, *, medium_model: Medium | Callable[[float], Me
         fields = stop.fields
     if first == "sphere" and fields.get("position") is not None:
         fields["sphere_radius"] = pr.radius
-    # A point found (or found but ambiguous, or at the edge of eps_range: a sphere's
-    # better fit may settle it) may turn out to be a sphere whose size shows.
+    # A point found (or found but ambiguous between rivals: a sphere's better fit may
+    # settle it) may turn out to be a sphere whose size shows.
     found = fields.get("position") is not None and fields.get("detection", 0.0) >= fields.get(
-        "detection_threshold", np.inf) and bool(run.search.best)
+        "detection_threshold", np.inf) and bool(run.search.best) and (
+        fields.get("determinable") or str(fields.get("reason", "")).startswith("ambiguous"))
     if first == "point" and found:
         best = run.search.best
         e0 = max(best, key=lambda e: best[e][0])
