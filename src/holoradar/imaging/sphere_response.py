@@ -180,9 +180,8 @@ class SphereResponse(PointResponse):
         V = abs((n_in - n_up) / (n_in + n_up))
         k_g = self.ks * n_in
         a_s = self._radius(xy)
-        back = np.array([abs(pec_sphere_amplitudes(x, np.array([np.pi]))[0][0])
-                         for x in k_g * a_s])
-        share = V * back / (np.abs(k_g) * 2 * (float(z) - above))
+        x = k_g * a_s
+        share = V * np.abs(sphere_backscatter(x) * x) / (np.abs(k_g) * 2 * (float(z) - above))
         fitted = np.sum(np.abs(self.model(g, a)) ** 2, axis=1)
         return float(np.sum(share**2 * fitted))
 

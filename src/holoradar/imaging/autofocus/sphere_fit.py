@@ -108,14 +108,16 @@ def radius_scan(pr: SphereResponse, eps: float, z: float, xy: Any,
     return a, float(F), float(p[2]), p[:2]
 
 
-def worth_a_sphere(search: Search, eps: float, z: float, xy: Any) -> bool:
-    """Whether the point fit at (``eps``, ``z``, ``xy``) shows lack of fit (the residual's
-    smooth share or the sandwich factor above the Cramér-Rao note's levels)."""
-    stats = fit_statistics(search, eps, z, np.asarray(xy, float))
-    r, _, _ = search.pr.residual(eps, z, np.asarray(xy, float))
+def worth_a_sphere(search: Search, eps: float, z: float, xy: Any) -> dict[str, float] | None:
+    """The point fit's statistics at (``eps``, ``z``, ``xy``) where it shows lack of fit
+    (the residual's smooth share or the sandwich factor above the Cramér-Rao note's
+    levels), else None."""
+    xy = np.asarray(xy, float)
+    stats = fit_statistics(search, eps, z, xy)
+    r, _, _ = search.pr.residual(eps, z, xy)
     R = float(np.vdot(r, r).real)
     smooth = stats["model_error"] / R if R > 0 else 0.0
-    return bool(smooth > _LACK_SHARE or stats["phi"] > _LACK_PHI)
+    return stats if smooth > _LACK_SHARE or stats["phi"] > _LACK_PHI else None
 
 
 def sphere_gain(point_F: float, sphere_F: float, energy: float, s2: float) -> bool:
@@ -146,13 +148,13 @@ def sphere_instead(run: Run, hologram: Hologram, coherent: bool, fit: str, depth
     point = run.search
     lam = shortest_wavelength(hologram)
     pr = sphere_model(hologram, run.make, coherent, fit == "phase", lam / 10)
-    if pr is None or (not forced and not worth_a_sphere(point, e, z, (x, y))):
+    stats = None if pr is None or forced else worth_a_sphere(point, e, z, (x, y))
+    if pr is None or (not forced and stats is None):
         return None
     a, F_s, _, xy_s = radius_scan(pr, e, z, (x, y), lam)
-    if not forced:
-        s2 = fit_statistics(point, e, z, np.array([x, y]))["s2"]
-        if not sphere_gain(float(fields["focus_fraction"]), F_s, point.pr.energy, s2):
-            return None
+    if stats is not None and not sphere_gain(float(fields["focus_fraction"]), F_s,
+                                             point.pr.energy, stats["s2"]):
+        return None
     pr.radius, pr.fit_radius = a, True
     search = Search(pr, run.make, run.lo, run.hi, hologram, point.bar)
     sphere_run = Run(search, run.make, run.lo, run.hi, run.z0, run.confidence, run.glare,
