@@ -34,8 +34,10 @@ class HologramFitError(ValueError):
     ----------
     reason : str
         ``"type"`` (not a Hologram), ``"frames"`` (several frames), ``"tilted"`` (not a
-        level aperture at z = 0), ``"grid"`` (the image's grid is not the elements' at a
-        whole upsampling), ``"mismatch"`` (the image is not its migration).
+        level aperture at z = 0), ``"frequency"`` (the image's frequencies are not the
+        hologram's), ``"grid"`` (the image's grid is not the elements' at a whole
+        upsampling), ``"mismatch"`` (the image is not its migration: another source,
+        data, ground or option).
     difference : float or None
         ``"mismatch"``: how far the image and the hologram's migration differ, as a
         fraction of the image's peak.

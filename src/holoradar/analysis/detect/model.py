@@ -93,9 +93,21 @@ class HologramModel:
         expect_x = hologram.x[0] + np.arange(u * (hologram.x.size - 1) + 1) * dx / u
         if u < 1 or expect_x.size != volume.x.size or not np.allclose(expect_x, volume.x,
                                                                       atol=1e-9 + 1e-6 * dx):
-            raise HologramFitError("image does not come from hologram: its x grid is not the "
-                                   "elements' at an integer upsampling (migrate(..., "
-                                   "upsample=u), fov='aperture')", "grid")
+            raise HologramFitError(
+                "hologram does not match image: the image's x grid ("
+                f"{volume.x.size} pixels, {volume.x[0]:.4g} .. {volume.x[-1]:.4g} m) is not "
+                f"the hologram's {hologram.x.size} elements ({hologram.x[0]:.4g} .. "
+                f"{hologram.x[-1]:.4g} m) at a whole upsampling (migrate(..., upsample=u), "
+                "fov='aperture')", "grid")
+        dy = hologram.pitch[1]
+        expect_y = hologram.y[0] + np.arange(u * (hologram.y.size - 1) + 1) * dy / u
+        if expect_y.size != volume.y.size or not np.allclose(expect_y, volume.y,
+                                                             atol=1e-9 + 1e-6 * dy):
+            raise HologramFitError(
+                "hologram does not match image: the image's y grid ("
+                f"{volume.y.size} pixels, {volume.y[0]:.4g} .. {volume.y[-1]:.4g} m) is not "
+                f"the hologram's {hologram.y.size} elements ({hologram.y[0]:.4g} .. "
+                f"{hologram.y[-1]:.4g} m) upsampled {u}x as along x", "grid")
         self.hologram = hologram
         self.vol = volume
         self.medium = medium
@@ -163,11 +175,12 @@ class HologramModel:
         ref = self.vol.data if self.vol.planar else self.vol.data[planes]
         err = float(np.max(np.abs(img - ref))) / scale
         if not err < 1e-5:
-            raise HologramFitError("image is not migrate(hologram, image.z, medium=medium, "
-                                   f"upsample={self.options['upsample']}) (they differ by "
-                                   f"{err:.2g} of the peak); pass the migration's other "
-                                   "options as migrate_options={...}, or leave hologram out",
-                                   "mismatch", err)
+            raise HologramFitError("hologram does not match image: the image is not "
+                                   "migrate(hologram, image.z, medium=medium, upsample="
+                                   f"{self.options['upsample']}) (they differ by {err:.2g} of "
+                                   "the peak: another source, data, ground or option); pass "
+                                   "the migration's other options as migrate_options={...}, "
+                                   "or leave hologram out", "mismatch", err)
         return self.vol.data.copy()
 
     # ----------------------------------------------------------------- the fit

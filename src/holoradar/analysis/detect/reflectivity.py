@@ -52,6 +52,12 @@ __all__ = ["SPARSE_VOXELS", "detect_by_inversion"]
 
 SPARSE_VOXELS = 3_000_000   # voxel-frequencies up to which the sparse method is used
 GRID_CELLS = 0.5            # the inversion grid's pixel, in lateral resolution cells
+#: The inversion's plane spacing, in range cells c / (2 B n). Range peaks closer than
+#: half a range cell join (one object); on planes ``d`` apart each peak sits within
+#: ``d / 2`` of its object and a dip needs a plane between two peaks, so two objects
+#: ``s`` apart are told apart for certain when ``s - d >= max(1/2, 2 d)``: a quarter
+#: cell separates objects 0.75 of a range cell apart (half a cell joined them).
+RANGE_GRID_CELLS = 0.25
 MAX_ITER = 300              # the sparse solver's steps in detect
 PROBE_ITER = 100            # its steps where the first fit only measures the noise
 LSQR_PROBE_ITER = 30        # least squares' steps for that (it converges in tens)
@@ -80,6 +86,7 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
             "image must be in the ground frame of hologram's posed (tilted or moved) array: "
             "migrate(hologram, z, medium=medium, frame='ground', x=..., y=...); the "
             "reflectivity is inverted on its world planes", "tilted")
+    _check_same_frequencies(vol, hologram)
     grid, level = _grid(vol, hologram, medium, options)
     model = None
     if level:
@@ -169,16 +176,35 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     return rows, meta
 
 
+def _check_same_frequencies(vol: Volume, hologram: Any) -> None:
+    """The image's frequencies (where it carries them) must be the hologram's: another
+    band images other objects, and the inversion would look where the image does not."""
+    if vol.frequency is None:
+        return
+    fi = np.atleast_1d(np.asarray(vol.frequency, float)).ravel()
+    fh = np.atleast_1d(np.asarray(hologram.frequencies, float)).ravel()
+    if fi.size == fh.size and np.allclose(fi, fh, rtol=1e-9, atol=0):
+        return
+
+    def say(f: np.ndarray) -> str:
+        return (f"{f.size} frequencies {f.min() / 1e9:.4g}-{f.max() / 1e9:.4g} GHz"
+                if f.size > 1 else f"one frequency {f[0] / 1e9:.4g} GHz")
+
+    raise HologramFitError(f"hologram does not match image: its {say(fh)} are not the "
+                           f"image's {say(fi)}; pass the hologram the image was migrated "
+                           "from (or leave hologram out)", "frequency")
+
+
 def _planes(z: np.ndarray, range_cell: float) -> np.ndarray:
     """The image's planes the inversion is solved on: across a band, every plane up to
-    :data:`GRID_CELLS` of a range cell apart, more finely sampled ones thinned to that
-    (a range cell holds one independent voxel in range; finer planes make nearly
-    parallel columns, which cost steps and spread an object over them), the first and
-    the last kept; one frequency (``range_cell`` 0): every plane."""
+    :data:`RANGE_GRID_CELLS` of a range cell apart, more finely sampled ones thinned to
+    that (finer planes make nearly parallel columns, which cost steps and spread an
+    object over them), the first and the last kept; one frequency (``range_cell`` 0):
+    every plane."""
     z = np.atleast_1d(np.asarray(z, float))
     if z.size < 3 or not range_cell > 0:
         return z
-    step = max(1, math.floor(GRID_CELLS * range_cell / float(np.min(np.diff(z)))))
+    step = max(1, math.floor(RANGE_GRID_CELLS * range_cell / float(np.min(np.diff(z)))))
     keep = np.unique(np.r_[np.arange(0, z.size, step), z.size - 1])
     return z[keep]
 
