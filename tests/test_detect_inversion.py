@@ -187,6 +187,11 @@ def test_cli_searches_a_wideband_volume_without_its_hologram_as_the_library(mat_
     ref = hr.detect(hr.load(image), medium=conc)
     assert got["n_objects"] == len(ref)
     assert got["metadata"]["model"] == ref.attrs["model"] == "window, by planes"
+    # Six bars, or one line saying why none and what to pass.
+    if got["n_objects"] != 6:
+        note = got["metadata"]["note"]
+        assert got["n_objects"] == 0 and "\n" not in note
+        assert "image's own level" in note and "--hologram FILE" in note
 
 
 def test_the_floor_is_the_model_error_of_what_was_found_at_most():

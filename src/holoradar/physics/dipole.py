@@ -46,6 +46,27 @@ class Dipole:
     model (a hologram without a ``polarization``), give its component along the
     dipole's axis.
 
+    Data across a band are taken to be the field of one fixed moment at every
+    frequency, in these units (``4 pi eps0 / k^2`` times the SI field). Which
+    normalisation a file holds cannot be told from the data alone (it is a smooth
+    amplitude slope across the band, which a fit reads as a wrong permittivity or
+    depth); convert before building the hologram, ``f`` in Hz:
+
+    ==================================================  =============================
+    what the solver or the instrument gives             divide the field by
+    ==================================================  =============================
+    SI field of a fixed moment p (SMUTHI, an analytic   ``f**2`` (``k^2``, up to one
+    dipole, a MoM code's point source)                  constant)
+    field per unit source current, E/I (gprMax's        ``f`` (``p = i I dl / omega``)
+    ``hertzian_dipole``, FDTD transfer functions)
+    field per unit source voltage through an antenna    the antenna's calibration
+    (a VNA's S21 between real antennas)                 (``holoradar.calibrate``)
+    already a fixed moment in these units               nothing
+    ==================================================  =============================
+
+    One constant factor over the band (the current's phase, ``dl``, ``4 pi eps0``) is
+    the object's amplitude and needs no conversion.
+
     Examples
     --------
     >>> d = Dipole((-0.2, 0.0, 0.2), moment=(0, 1, 0))

@@ -44,6 +44,7 @@ from ...data.hologram import C0
 from ...imaging.inversion.noise import NoiseWarning
 from .errors import HologramFitError
 from .grid import Volume
+from .multiples import split_multiples
 from .table import depth_interval
 
 ndimage = lazy_module("scipy.ndimage")
@@ -166,13 +167,20 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     rows = [_row(ob, res.sigma, medium, interval, hologram) for ob in objects]
     if model is not None and any(row["kind"] == "point" for row in rows):
         _refine_points(rows, model, medium, interval, hologram.nf > 1)
+    multiples: list[dict[str, Any]] = []
+    if medium is not None and medium.z_interfaces and hologram.nf > 1:
+        rows, multiples = split_multiples(rows, cell, rcell)
     _spacing(rows)
     meta = {"threshold": float(res.threshold), "noise_std": float(res.sigma),
             "resolution_cell": [cell, cell, rcell if hologram.nf > 1 else None],
             "n_cells": float(n_cells),
             "model": f"reflectivity:{method}", "inversion": dict(step),
             "illumination": grid.get("illumination", "field"),
-            "model_error_floor": float(floor)}
+            "model_error_floor": float(floor),
+            # Surface multiples recognised (not objects): where, and whose.
+            "multiples": [{**{k: float(m[k]) for k in ("x", "y", "depth")}, "kind": m["kind"],
+                           **{f"of_{k}": float(rows[m["multiple_of"]][k])
+                              for k in ("x", "y", "depth")}} for m in multiples]}
     return rows, meta
 
 

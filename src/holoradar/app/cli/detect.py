@@ -321,14 +321,18 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
                                      param_hint="--out") from None
     none = "no object above the threshold"
     if info.get("input") == "image" and "hologram" not in info:
-        none += (" (from the image alone: --hologram, the file it was imaged from, reads "
-                 "the objects off the reflectivity inverted from it)")
+        none += (": from the image alone the noise is the image's own level, which echoes "
+                 "filling the image (a mat under the whole aperture) raise above every "
+                 "object; --hologram FILE (the file it was imaged from) reads them off the "
+                 "reflectivity inverted with the receiver noise")
     lines = table_lines(df) if len(df) else [none]
     counts = ", ".join(f"{int((df['kind'] == k).sum())} {k}(s)" for k in _KINDS
                        if (df["kind"] == k).any()) or "none"
     head = f"{file.name}: {len(df)} object(s) ({counts}), false alarm {args['false_alarm']:g} " \
            "per resolution cell"
     wrote = [f"wrote {p}" for p in written]
+    if not len(df):
+        metadata["note"] = none
     report.done({"objects": records(df), "n_objects": len(df), "metadata": metadata,
                  "out": None if out is None else str(out),
                  "files": [str(p) for p in written]},
