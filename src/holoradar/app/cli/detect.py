@@ -331,6 +331,15 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
     head = f"{file.name}: {len(df)} object(s) ({counts}), false alarm {args['false_alarm']:g} " \
            "per resolution cell"
     wrote = [f"wrote {p}" for p in written]
+    multiples = df.attrs.get("multiples") or []
+    if multiples:
+        # Said, not listed: an object's echo again at twice its depth is not an object.
+        from ..numbers import cm
+
+        lines.append(f"{len(multiples)} surface multiple(s), not objects: " + "; ".join(
+            f"{m['kind']} at x {cm(m['x'])} cm, depth {cm(m['depth'])} cm (twice the "
+            f"{cm(m['of_depth'])} cm of the object at x {cm(m['of_x'])} cm)"
+            for m in multiples))
     if not len(df):
         metadata["note"] = none
     report.done({"objects": records(df), "n_objects": len(df), "metadata": metadata,
