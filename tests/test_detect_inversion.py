@@ -192,6 +192,7 @@ def test_cli_searches_a_wideband_volume_without_its_hologram_as_the_library(mat_
         note = got["metadata"]["note"]
         assert got["n_objects"] == 0 and "\n" not in note
         assert "image's own level" in note and "--hologram FILE" in note
+        assert ref.attrs["note"] == note                 # the library says the same
 
 
 def test_the_floor_is_the_model_error_of_what_was_found_at_most():

@@ -15,6 +15,13 @@ __all__ = ["detect"]
 
 _KINDS = ("point", "line", "area")
 
+#: Why an image searched alone may give nothing, and what to pass instead.
+NOTHING_FROM_THE_IMAGE = (
+    "no object above the threshold: from the image alone the noise is the image's own "
+    "level, which echoes filling the image (a mat under the whole aperture) raise above "
+    "every object; pass the hologram it was imaged from (hologram=, --hologram FILE) to "
+    "read them off the reflectivity inverted with the receiver noise")
+
 
 def _check(false_alarm: Any, kinds: Any, medium: Any, eps_interval: Any) -> tuple[float, set[str]]:
     try:
@@ -178,6 +185,8 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
                     model.kind)
 
         rows, meta = detect_planes(vol, run_plane, fa, medium, interval)
+        if not rows:
+            meta["note"] = NOTHING_FROM_THE_IMAGE
         return _frame(rows, meta, fa, interval)
     model = _image_model(vol, medium)
     rows, result = _one(vol, model, medium, fa, ks, int(max_objects), interval)

@@ -321,10 +321,9 @@ def _done(file: Path, df: Any, info: dict[str, Any], medium: Any, args: dict[str
                                      param_hint="--out") from None
     none = "no object above the threshold"
     if info.get("input") == "image" and "hologram" not in info:
-        none += (": from the image alone the noise is the image's own level, which echoes "
-                 "filling the image (a mat under the whole aperture) raise above every "
-                 "object; --hologram FILE (the file it was imaged from) reads them off the "
-                 "reflectivity inverted with the receiver noise")
+        from ...analysis.detect.api import NOTHING_FROM_THE_IMAGE
+
+        none = NOTHING_FROM_THE_IMAGE
     lines = table_lines(df) if len(df) else [none]
     counts = ", ".join(f"{int((df['kind'] == k).sum())} {k}(s)" for k in _KINDS
                        if (df["kind"] == k).any()) or "none"
