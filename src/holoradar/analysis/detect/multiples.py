@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["AZIMUTH_DEG", "split_multiples"]
+__all__ = ["AZIMUTH_DEG", "line_offset", "split_multiples"]
 
 AZIMUTH_DEG = 10.0   # lines this parallel (degrees) can be one's multiple
 
@@ -72,12 +72,24 @@ def _repeats(b: dict[str, Any], a: dict[str, Any], cell: float, range_cell: floa
     if not (da > 0 and abs(db - 2 * da) <= range_cell / 2):
         return False
     if a["kind"] == "line" and b["kind"] == "line":
-        d_az = abs(a["azimuth_deg"] - b["azimuth_deg"]) % 180.0
-        if min(d_az, 180.0 - d_az) > AZIMUTH_DEG:
-            return False
-        t = math.radians(a["azimuth_deg"])
-        across = abs(-(b["x"] - a["x"]) * math.sin(t) + (b["y"] - a["y"]) * math.cos(t))
-        return across <= cell
+        d_az, across = line_offset(a, b)
+        return d_az <= AZIMUTH_DEG and across <= cell
     if a["kind"] == "line" or b["kind"] == "line":
         return False
     return math.hypot(b["x"] - a["x"], b["y"] - a["y"]) <= cell
+
+
+def line_offset(a: dict[str, Any], b: dict[str, Any]) -> tuple[float, float]:
+    """The angle between two lines' azimuths (degrees, 0-90) and ``b``'s centre's
+    distance from ``a``'s axis (metres).
+
+    Examples
+    --------
+    >>> line_offset({"x": 0.0, "y": 0.0, "azimuth_deg": 90.0},
+    ...             {"x": 0.07, "y": 0.02, "azimuth_deg": 268.0})
+    (2.0, 0.07)
+    """
+    d_az = abs(a["azimuth_deg"] - b["azimuth_deg"]) % 180.0
+    t = math.radians(a["azimuth_deg"])
+    across = abs(-(b["x"] - a["x"]) * math.sin(t) + (b["y"] - a["y"]) * math.cos(t))
+    return min(d_az, 180.0 - d_az), across

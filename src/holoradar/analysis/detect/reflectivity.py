@@ -44,7 +44,7 @@ from ...data.hologram import C0
 from ...imaging.inversion.noise import NoiseWarning
 from .errors import HologramFitError
 from .grid import Volume
-from .multiples import split_multiples
+from .multiples import line_offset, split_multiples
 from .table import depth_interval
 
 ndimage = lazy_module("scipy.ndimage")
@@ -510,12 +510,9 @@ def _spacing(rows: list[dict[str, Any]]) -> None:
         for b in lines:
             if b is a:
                 continue
-            d_az = abs(a["azimuth_deg"] - b["azimuth_deg"]) % 180.0
-            if min(d_az, 180.0 - d_az) > 15.0:
-                continue
-            t = math.radians(a["azimuth_deg"])
-            across = abs(-(b["x"] - a["x"]) * math.sin(t) + (b["y"] - a["y"]) * math.cos(t))
-            best = min(best, across)
+            d_az, across = line_offset(a, b)
+            if d_az <= 15.0:
+                best = min(best, across)
         a["spacing"] = best if np.isfinite(best) else np.nan
 
 
