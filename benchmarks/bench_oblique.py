@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 import holoradar as hr
-from holoradar.imaging import oblique, oblique_sum
+from holoradar.imaging.migration.backends import oblique, oblique_sum
 from holoradar.physics.propagation import clear_transfer_cache
 
 REPEAT = 7
@@ -125,7 +125,7 @@ sys.path.insert(0, {here!r})
 warnings.simplefilter("ignore")
 import bench_oblique as b
 import holoradar as hr
-from holoradar.imaging import oblique_sum
+from holoradar.imaging.migration.backends import oblique_sum
 case = b._CASES[{name!r}]
 if case is None:
     args = b._spectrum_args({name!r})
@@ -191,7 +191,7 @@ def spectrum_routes() -> dict:
 
 
 def oblique_nufft_eps(work: np.dtype) -> float:
-    from holoradar.imaging.oblique_nufft import EPS
+    from holoradar.imaging.migration.backends.oblique_nufft import EPS
     return EPS[np.dtype(work)]
 
 

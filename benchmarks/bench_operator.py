@@ -124,7 +124,10 @@ def setup(case: str) -> tuple:
 def _ground_grid(h, sand) -> tuple[int, int]:
     """The world FFT grid the ground frame uses for this case (either tree)."""
     try:
-        from holoradar.imaging.oblique import ground_setup
+        try:
+            from holoradar.imaging.migration.backends.oblique import ground_setup
+        except ImportError:                 # a tree before the backends' folder
+            from holoradar.imaging.oblique import ground_setup
     except ImportError:                     # the tree before the operator
         import holoradar.imaging.oblique as ob
 

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging import columns
+from holoradar.imaging.migration.backends import columns
 from holoradar.physics.propagation import padded_shape
 
 FREQS = np.linspace(8e9, 12e9, 21)          # df = 200 MHz: unambiguous range 75 cm

@@ -226,7 +226,7 @@ def test_unasked_progress_bar_only_on_a_terminal(monkeypatch):
     import sys
     from types import SimpleNamespace
 
-    from holoradar.imaging.migration.planes import _Progress
+    from holoradar.imaging.migration.backends.planes import _Progress
 
     plan = SimpleNamespace(settings=SimpleNamespace(progress=None, upsample=1),
                            z=np.zeros(1000), grid=(512, 512))

@@ -14,9 +14,9 @@ import pytest
 
 import holoradar as hr
 from conftest import migrate64
-from holoradar.imaging import columns, kspace
 from holoradar.imaging.migration import memory
 from holoradar.imaging.migration import plan as migration_plan
+from holoradar.imaging.migration.backends import columns, kspace
 
 FREQS = np.linspace(8e9, 12e9, 11)
 ZS = np.linspace(0.16, 0.30, 29)

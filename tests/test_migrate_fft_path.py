@@ -13,7 +13,7 @@ import scipy.fft as sfft
 
 import holoradar as hr
 from conftest import migrate64
-from holoradar.imaging.migration import planes as planes_module
+from holoradar.imaging.migration.backends import planes as planes_module
 from holoradar.physics.propagation import AngularSpectrum
 
 F0 = 9.9e9

@@ -18,7 +18,7 @@ import pytest
 import scipy.fft as sfft
 
 import holoradar as hr
-from holoradar.imaging import kspace, stolt
+from holoradar.imaging.migration.backends import kspace, stolt
 
 FREQS = np.linspace(8e9, 12e9, 11)
 ZS = np.linspace(0.16, 0.30, 29)

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging.oblique_nufft import EPS
+from holoradar.imaging.migration.backends.oblique_nufft import EPS
 
 F0 = 9.9e9
 BAND = np.linspace(8e9, 12e9, 5)

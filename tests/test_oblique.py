@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging.oblique_sum import sum_to_plane
+from holoradar.imaging.migration.backends.oblique_sum import sum_to_plane
 from holoradar.physics.green import layered_green
 from holoradar.theory import range_resolution
 
@@ -508,7 +508,7 @@ def test_raised_level_views_synthesize_in_their_own_frame():
 def test_default_ground_grid_covers_the_footprint_of_a_raised_tilted_array():
     """The corners carried along the normal through 20 cm of air above z = 0 and on
     into the sand (Snell): the grid must reach every such point (within a pitch)."""
-    from holoradar.imaging.oblique import ground_grid
+    from holoradar.imaging.migration.backends.oblique import ground_grid
 
     sand = hr.Medium.half_space(0.3, 4.0)
     pose = hr.Pose((0.0, 0.0, -0.2), tilt=np.radians(35))

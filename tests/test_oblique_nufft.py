@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging import oblique_sum as oblique
-from holoradar.imaging.oblique_nufft import EPS
-from holoradar.imaging.oblique_sum import choose_route
+from holoradar.imaging.migration.backends import oblique_sum as oblique
+from holoradar.imaging.migration.backends.oblique_nufft import EPS
+from holoradar.imaging.migration.backends.oblique_sum import choose_route
 
 F0 = 9.9e9
 

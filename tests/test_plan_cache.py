@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import holoradar as hr
-from holoradar.imaging import columns
+from holoradar.imaging.migration.backends import columns
 from holoradar.physics.propagation import clear_transfer_cache
 
 

@@ -103,7 +103,7 @@ def test_forward_is_simulates_point_target(medium):
 
 def test_kernel_through_the_ground_matches_the_direct_integral():
     """Each leg's interpolated profile against the Sommerfeld integral at the lags."""
-    from holoradar.imaging.migration.offset import _lags, kernels
+    from holoradar.imaging.migration.backends.offset import _lags, kernels
 
     med = hr.Medium.half_space(0.08, 5 + 0.3j)
     h = _point((0.0, 0.0, 0.15), med, f=[7e9, 8e9])

@@ -126,13 +126,14 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         and plane; the same result to rounding), which needs uniformly spaced
         planes in the deepest region, ``fov="aperture"``, ``combine="coherent"``, a
         transceiver or a normal plane wave, and no loss to compensate
-        (:mod:`holoradar.imaging.kspace`, a NumPy recurrence: the reference).
-        ``"auto"`` (default) computes that same sum where it applies, by a compiled
-        loop over the spectral columns when numba is installed
-        (:mod:`holoradar.imaging.columns`, equal to ``"kspace"`` to rounding), else
-        by ``"kspace"``; elsewhere ``"frequency"``. ``"stolt"``: Stolt's migration,
-        each column's plane waves interpolated onto a uniform kz grid, then one
-        inverse FFT along z (:mod:`holoradar.imaging.stolt`): propagating waves
+        (:mod:`~holoradar.imaging.migration.backends.kspace`, a NumPy recurrence:
+        the reference). ``"auto"`` (default) computes that same sum where it
+        applies, by a compiled loop over the spectral columns when numba is
+        installed (:mod:`~holoradar.imaging.migration.backends.columns`, equal to
+        ``"kspace"`` to rounding), else by ``"kspace"``; elsewhere ``"frequency"``.
+        ``"stolt"``: Stolt's migration, each column's plane waves interpolated onto
+        a uniform kz grid, then one inverse FFT along z
+        (:mod:`~holoradar.imaging.migration.backends.stolt`): propagating waves
         only, no per-plane band limit, each plane wave's error at most 0.9% of
         its amplitude; it applies where ``"kspace"`` does, except a receiver array
         without ``hologram.source``, and raises a ``ValueError`` naming what
@@ -146,7 +147,8 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
         refraction, pixels in world coordinates over the aperture's footprint
         (or ``x``, ``y``): for a tilted aperture (``hologram.pose``). Method: an
         exact rotation of the angular spectrum onto a horizontal reference plane
-        (:mod:`holoradar.imaging.oblique`), then the same migration.
+        (:mod:`~holoradar.imaging.migration.backends.oblique`), then the same
+        migration.
     x, y : array_like, optional
         ``frame="ground"``: uniform world grids of the image, metres (default:
         the footprint of the elements at their pitch / ``upsample``).

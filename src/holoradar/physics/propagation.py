@@ -302,7 +302,7 @@ def register_cache(cache: _TransferCache) -> _TransferCache:
 
 def clear_transfer_cache() -> None:
     """Free the cached transfer functions (at most 256 MiB are kept) and the wideband
-    sum's plans (:data:`holoradar.imaging.columns.PLAN_CACHE`)."""
+    sum's plans (:data:`holoradar.imaging.migration.backends.columns.PLAN_CACHE`)."""
     for cache in _CACHES:
         cache.clear()
 

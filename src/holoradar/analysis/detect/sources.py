@@ -128,7 +128,7 @@ def level(holo: Any, medium: Any) -> tuple[Any, Any]:
 def from_array(medium: Any, height: float) -> Any:
     """The ground seen from an array at world height ``height`` (m; ``migrate``'s shift):
     interfaces at ranges from the array, so that depths below the surface come out."""
-    from ...imaging.oblique import _shifted
+    from ...imaging.migration.backends.oblique import _shifted
 
     if medium is None or height == 0.0:
         return medium

@@ -17,12 +17,12 @@ from __future__ import annotations
 import math
 
 from ...physics.propagation import transfer_cache_bytes
-from .backend import Backend
-from .ground import GroundDirect, GroundNufft
-from .offset import Offset
-from .phase_shift import Columns, PhaseShift, Stolt
+from .backends.base import Backend
+from .backends.ground import GroundDirect, GroundNufft
+from .backends.offset import Offset
+from .backends.phase_shift import Columns, PhaseShift, Stolt
+from .backends.planes import FresnelPlanes, PlaneByPlane
 from .plan import MigrationPlan
-from .planes import FresnelPlanes, PlaneByPlane
 
 __all__ = ["BACKENDS", "choose"]
 

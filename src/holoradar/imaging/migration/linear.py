@@ -24,7 +24,7 @@ import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
 from ...data.hologram import Hologram, Image
-from .backend import Backend
+from .backends.base import Backend
 from .choose import choose
 from .plan import MigrationPlan, make_plan, without_data
 from .sampling import decimate, fine_hologram, oversampling, zero_insert

@@ -1,7 +1,7 @@
 """Horizontal world planes from a posed (tilted) aperture: ``frame="ground"``.
 
 Each frequency's data are summed onto the plane waves of a horizontal reference
-plane through the lowest element (the spectrum's sum, :mod:`holoradar.imaging.oblique`)
+plane through the lowest element (the spectrum's sum, :mod:`.oblique`)
 and carried down through the layers onto the world planes. Two backends differ in
 that sum only: ``"ground-direct"`` (factored matrix products, exact) and
 ``"ground-nufft"`` (finufft, to 1e-6 in complex128, 1e-5 in complex64; the elements on
@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import oblique, oblique_sum
-from ..oblique import GroundGrid
-from . import illumination, units
-from .backend import Backend
-from .plan import MigrationPlan
+from .. import illumination, units
+from ..plan import MigrationPlan
+from . import oblique, oblique_sum
+from .base import Backend
+from .oblique import GroundGrid
 
 __all__ = ["GroundDirect", "GroundNufft"]
 

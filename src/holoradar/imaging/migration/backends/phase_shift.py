@@ -3,8 +3,8 @@
 
 Below the last interface each plane wave's transfer grows from plane to plane by one
 factor, so a band's coherent sum is carried from plane to plane in the wavenumber
-domain (:mod:`holoradar.imaging.kspace`, :mod:`holoradar.imaging.columns`,
-:mod:`holoradar.imaging.stolt`). The three share what they need and refuse alike:
+domain (:mod:`.kspace`, :mod:`.columns`,
+:mod:`.stolt`). The three share what they need and refuse alike:
 uniformly spaced planes in the deepest region, the exact angular spectrum on the
 aperture's own footprint, a coherent sum, an illumination the same across each plane
 (a transceiver, or a plane wave at normal incidence, or none) and no loss to
@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import columns, kspace, stolt
-from . import illumination, units
-from .backend import Backend, uniform_planes
-from .plan import MigrationPlan
+from .. import illumination, units
+from ..plan import MigrationPlan
+from . import columns, kspace, stolt
+from .base import Backend, uniform_planes
 
 __all__ = ["Columns", "PhaseShift", "Stolt"]
 

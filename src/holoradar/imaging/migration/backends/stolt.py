@@ -7,7 +7,7 @@ Within the deepest region the coherent wideband image's spectrum on uniform plan
     I(kx, ky, z_j) = sum_f A_f exp(-i theta_f j),   theta_f = Re(Kz_f) dz  [+ k_f n dz],
 
 ``A_f`` the weighted spectrum taken to the first plane (the terms of
-:mod:`holoradar.imaging.kspace`; the bracket: a receiver array's incident phase).
+:mod:`.kspace`; the bracket: a receiver array's incident phase).
 Stolt's step puts each propagating term that every plane needs on a uniform grid of
 ``M = OVERSAMPLE * nz`` phases
 ``2 pi m / M`` (cubic Lagrange weights on the four nearest nodes, the phase referred to
@@ -41,10 +41,10 @@ from typing import Any
 
 import numpy as np
 
-from .._lazy import lazy_module
-from .._threads import fft_workers
-from ..physics.medium import Medium
-from ..physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
+from ...._lazy import lazy_module
+from ...._threads import fft_workers
+from ....physics.medium import Medium
+from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
 from . import kspace
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy

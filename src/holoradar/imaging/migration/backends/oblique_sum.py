@@ -21,9 +21,9 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import uniform_step
-from ..data.hologram import Hologram
-from ..physics.propagation import TRANSFER_CACHE, spectral_axes
+from ...._validate import uniform_step
+from ....data.hologram import Hologram
+from ....physics.propagation import TRANSFER_CACHE, spectral_axes
 from .oblique_nufft import elements_nufft, spectrum_nufft
 
 #: Components evanescent in the air damped below this over the air gap are left out.

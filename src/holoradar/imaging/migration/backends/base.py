@@ -20,7 +20,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .plan import MigrationPlan
+from ..plan import MigrationPlan
 
 __all__ = ["Backend", "uniform_planes"]
 

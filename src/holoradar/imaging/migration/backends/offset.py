@@ -37,13 +37,13 @@ import math
 
 import numpy as np
 
-from ..._lazy import lazy_module
-from ..._threads import POOL_SIZE
-from ...physics.green import transmitted_profiles
-from ...physics.medium import Medium
-from . import units
-from .backend import Backend
-from .plan import MigrationPlan
+from ...._lazy import lazy_module
+from ...._threads import POOL_SIZE
+from ....physics.green import transmitted_profiles
+from ....physics.medium import Medium
+from .. import units
+from ..plan import MigrationPlan
+from .base import Backend
 
 sfft = lazy_module("scipy.fft")
 

@@ -1,6 +1,6 @@
 """The spectrum of a posed hologram on the world grid by a library non-uniform FFT.
 
-The ground-frame imaging path (:mod:`holoradar.imaging.oblique`) needs the data's
+The ground-frame imaging path (:mod:`.oblique`) needs the data's
 spectrum on a horizontal reference plane at every world-grid wavenumber,
 
     H(k) = sum_e d_e exp(-i K.(r_e - r0)),   K = (p, q, -conj(kz)),
@@ -15,7 +15,7 @@ applies; it aims at a relative l2 error ``eps`` (:data:`EPS`: 1e-6 in complex128
 1e-5 in complex64; measured within 2 eps). The elements must lie on a uniform grid.
 
 The components evanescent in the air (``kz = i kappa``) that the air gap keeps
-(``kappa`` below the floor of :mod:`~holoradar.imaging.oblique`) have complex
+(``kappa`` below the floor of :mod:`.oblique`) have complex
 ``s``, ``t`` when the aperture is tilted: they are summed directly, on that subset
 only, factored by the aperture's axes (by grid column when ``x'`` lies along the
 world ``x``, by grid row when ``y'`` lies along ``y``, then by Horner's rule along
@@ -32,10 +32,10 @@ from typing import Any
 
 import numpy as np
 
-from .._lazy import lazy_module
-from .._validate import uniform_step
-from ..data.hologram import Hologram
-from ..physics.propagation import TRANSFER_CACHE, spectral_axes
+from ...._lazy import lazy_module
+from ...._validate import uniform_step
+from ....data.hologram import Hologram
+from ....physics.propagation import TRANSFER_CACHE, spectral_axes
 
 finufft = lazy_module("finufft")  # imported on first use: see holoradar._lazy
 

@@ -6,8 +6,8 @@ needs, the coherent image's spectrum on uniform planes ``z_j = z_0 + j dz`` is
     I(kx, ky, z_j) = sum_f A_f(kx, ky) s_f(kx, ky)^j,   j <= jmax_f(kx, ky),
 
 ``A_f`` the weighted spectrum taken to the first plane and ``s_f = exp(-i conj(Kz_f) dz)``
-the plane-to-plane step (the same terms as :mod:`holoradar.imaging.kspace`, built by
-:func:`~holoradar.imaging.kspace.frequency_terms`: in a half-space the ground's
+the plane-to-plane step (the same terms as :mod:`.kspace`, built by
+:func:`.kspace.frequency_terms`: in a half-space the ground's
 ``Kz`` after the air gap's transfer; for a receiver array the normal plane wave's
 incident phase). A compiled loop (numba) carries each column's ``nf`` terms from plane
 to plane: ``nf`` complex multiply-adds per component and plane, run over blocks of
@@ -15,7 +15,7 @@ components in cache, real and imaginary parts apart so that the compiler vectori
 them. Each block of planes is then one pruned inverse FFT (along x over the rows that
 hold components, cropped to the aperture, then along y).
 
-The result is the phase-shift sum of :func:`holoradar.imaging.kspace.migrate_kspace`
+The result is the phase-shift sum of :func:`.kspace.migrate_kspace`
 to rounding: the recurrence's error grows by one rounding per step, ``~j eps``
 (``eps`` = 6e-8 in complex64, 1.1e-16 in complex128).
 
@@ -35,12 +35,12 @@ from typing import Any
 
 import numpy as np
 
-from .. import _threads
-from .._lazy import lazy_module
-from .._threads import fft_workers, pool
-from ..physics.medium import Medium
-from ..physics.propagation import _TransferCache, register_cache
-from ..physics.spectra import interpolate
+from .... import _threads
+from ...._lazy import lazy_module
+from ...._threads import fft_workers, pool
+from ....physics.medium import Medium
+from ....physics.propagation import _TransferCache, register_cache
+from ....physics.spectra import interpolate
 from . import kspace
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy

@@ -26,14 +26,14 @@ from typing import Any
 
 import numpy as np
 
-from ... import _threads
-from ..._lazy import lazy_module
-from ..._threads import pool
-from ...physics.propagation import AngularSpectrum, Fresnel, _PlaneOperator
-from ...physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
-from . import illumination, units
-from .backend import Backend
-from .plan import MigrationPlan
+from .... import _threads
+from ...._lazy import lazy_module
+from ...._threads import pool
+from ....physics.propagation import AngularSpectrum, Fresnel, _PlaneOperator
+from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
+from .. import illumination, units
+from ..plan import MigrationPlan
+from .base import Backend
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 

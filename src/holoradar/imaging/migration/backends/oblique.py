@@ -39,12 +39,12 @@ from typing import Any
 
 import numpy as np
 
-from .._lazy import lazy_module
-from .._threads import fft_workers
-from .._validate import as_axis, uniform_step
-from ..data.hologram import Hologram
-from ..physics.medium import Medium
-from ..physics.propagation import (
+from ...._lazy import lazy_module
+from ...._threads import fft_workers
+from ...._validate import as_axis, uniform_step
+from ....data.hologram import Hologram
+from ....physics.medium import Medium
+from ....physics.propagation import (
     TRANSFER_CACHE,
     band_taper,
     basis_of,
@@ -52,7 +52,7 @@ from ..physics.propagation import (
     make_angular_transfer,
     padded_shape,
 )
-from ..physics.spectra import fft2_padded, fold, interpolate
+from ....physics.spectra import fft2_padded, fold, interpolate
 from .oblique_sum import EVANESCENT_FLOOR, sum_to_elements, sum_to_plane
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy

@@ -31,10 +31,10 @@ from typing import Any
 
 import numpy as np
 
-from .._lazy import lazy_module
-from .._threads import fft_workers
-from ..physics.medium import Medium
-from ..physics.propagation import (
+from ...._lazy import lazy_module
+from ...._threads import fft_workers
+from ....physics.medium import Medium
+from ....physics.propagation import (
     TRANSFER_CACHE,
     inverse_kz,
     lateral_travel,
@@ -44,7 +44,7 @@ from ..physics.propagation import (
     spectral_step,
     two_way_transfer,
 )
-from ..physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
+from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
