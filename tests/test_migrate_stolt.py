@@ -19,6 +19,7 @@ import scipy.fft as sfft
 
 import holoradar as hr
 from holoradar.imaging.migration.backends import kspace, stolt
+from holoradar.imaging.migration.backends.terms import TermsKey
 
 FREQS = np.linspace(8e9, 12e9, 11)
 ZS = np.linspace(0.16, 0.30, 29)
@@ -45,9 +46,10 @@ def _bound(h: hr.Hologram, medium: hr.Medium, zs: np.ndarray) -> float:
     grid = h.data.shape[-2:]
     dx, dy = h.pitch
     nz = zs.size
-    gain, step, jmax, unfold = kspace.frequency_terms(
-        grid, dx, dy, tuple(h.wavenumbers), float(zs[0]), float(zs[1] - zs[0]), nz, medium,
-        h.monostatic, True, np.dtype(np.complex128), np.ones(h.nf, bool))
+    gain, step, jmax, unfold = kspace.frequency_terms(TermsKey(
+        grid, (dx, dy), tuple(h.wavenumbers), float(zs[0]), float(zs[1] - zs[0]), nz, medium,
+        h.monostatic, "none" if h.monostatic else "phase", None, None,
+        np.dtype(np.complex128), (True,) * h.nf))
     full = (np.abs(np.abs(step[:, unfold]) - 1) < 1e-6) & (jmax >= nz - 1)
     A = np.abs(sfft.fft2(h.data).reshape(h.nf, -1) * gain[:, unfold]) * full
     return stolt.ERROR_BOUND * float(np.sqrt(nz * np.sum(A.sum(axis=0) ** 2)))

@@ -38,10 +38,11 @@ import numpy as np
 from .... import _threads
 from ...._lazy import lazy_module
 from ...._threads import fft_workers, pool
-from ....physics.medium import Medium
 from ....physics.propagation import _TransferCache, register_cache
 from ....physics.spectra import interpolate
 from . import kspace
+from . import terms as terms_mod
+from .terms import TermsKey
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -55,7 +56,7 @@ _BUFFER_MIN = 1 << 24  # or 16 MiB
 #: A term whose weight fell below this fraction of its frequency's largest is dropped:
 #: below the working precision's rounding (complex64: 6e-8), 1e-17 in complex128 (by
 #: dtype character; the forward map drops the same terms).
-TINY = {"F": 1e-9, "D": kspace._TINY}
+TINY = {"F": 1e-9, "D": terms_mod.TINY}
 
 
 def _plan_budget() -> int:
@@ -216,61 +217,48 @@ def _run(kernel: Any, plan: ColumnPlan, ar: np.ndarray, ai: np.ndarray, j0: int,
                     range(nt)))
 
 
-def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
-                    zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
-                    pad: Any, upsample: int, work: np.dtype, incident: str,
-                    point_area: float | None = None,
-                    pol: tuple[float, float] | None = None) -> np.ndarray:
-    """The coherent wideband image on uniform planes ``zs`` by the compiled column sum.
+def adjoint_columns(data: np.ndarray, terms: TermsKey, weights: np.ndarray,
+                    upsample: int = 1) -> np.ndarray:
+    """The coherent wideband image on the uniform planes of ``terms`` by the compiled
+    column sum.
 
     Parameters
     ----------
     data : numpy.ndarray
         ``(B, nf, ny, nx)``: a transceiver's, or a receiver array's lit by a normal
         plane wave (or none: phase 0 at the aperture assumed).
-    pitch : (dx, dy)
-        Element pitch, metres.
-    ks : numpy.ndarray
-        Wavenumbers in air, rad/m (nf,).
-    zs : numpy.ndarray
-        Uniformly spaced ranges, metres, all in the medium's deepest region.
-    medium : Medium
-        The layers (free space included); lossless, or loss left uncompensated.
-    mono : bool
-        A scanned transceiver's round trip.
+    terms : TermsKey
+        The band, the planes (uniformly spaced, all in the medium's deepest region),
+        the layers (lossless, or loss left uncompensated), the model's factors, the
+        FFT grid and the working dtype (:class:`.terms.TermsKey`); its ``tiny`` is
+        used as given (``TINY[work.char]`` is the compiled loop's own).
     weights : numpy.ndarray
         One weight per frequency.
-    pad, upsample, work
-        As in :func:`holoradar.migrate` (``work`` the working dtype).
-    incident : {"none", "phase", "field"}
-        A receiver array's normal plane wave factor (:func:`.kspace.frequency_terms`).
-    point_area : float, optional
-        A receiver array's voxels as point scatterers of that cell, square metres
-        (:func:`.kspace.frequency_terms`).
-    pol : (float, float), optional
-        The vector model's recorded component (its x, y): the dipole factor.
+    upsample : int
+        Output pixels per pitch, as in :func:`holoradar.migrate`.
 
     Returns
     -------
     numpy.ndarray
         ``(B, nz, ny', nx')``: the same sum as :func:`.kspace.adjoint_kspace`, to
-        rounding; its exact adjoint is :func:`.kspace.forward_kspace` with
-        ``tiny=TINY[work.char]``.
+        rounding; its exact adjoint is :func:`.kspace.forward_kspace` with the same
+        ``terms``.
+
+    Examples
+    --------
+    Through :func:`holoradar.migrate` (``algorithm="columns"``), which makes the key
+    from its plan (:meth:`.terms.TermsKey.of`).
     """
-    dx, dy = pitch
     ny, nx = data.shape[-2:]
+    work, zs_size, grid = terms.work, terms.nz, terms.grid
     real = np.float32 if work == np.complex64 else np.float64
-    grid = kspace.band_grid((ny, nx), pitch, ks, mono, pad, float(zs.max()))
     workers = fft_workers(grid[0] * grid[1])
     weights = np.asarray(weights, dtype=float)
     u = int(upsample)
     direct = u == 1 and grid == (ny, nx)
-    key = ("columns", grid, dx, dy, tuple(float(k) for k in ks),
-           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
-           pol, direct, work.str, tuple(weights != 0))
-    plan = PLAN_CACHE.get(key, lambda: ColumnPlan.build(*key[1:-2], work, np.asarray(key[-1])))
+    plan = PLAN_CACHE.get(("columns", terms, direct), lambda: ColumnPlan.build(terms, direct))
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
+    out = np.empty((data.shape[0], zs_size, oy, ox), dtype=work)
     run = _kernel()
     My, Mx = grid
     zero = real(0)
@@ -280,8 +268,8 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
         chunk = 16
         for b in range(data.shape[0]):
             ar, ai = plan.gather(data[b], weights, work, workers)
-            for j0 in range(0, zs.size, chunk):
-                j1 = min(zs.size, j0 + chunk)
+            for j0 in range(0, zs_size, chunk):
+                j1 = min(zs_size, j0 + chunk)
                 o = out[b, j0:j1]
                 o.fill(0)
                 _run(run, plan, ar, ai, j0, j1, zero, o.view(real).reshape(j1 - j0, -1))
@@ -296,8 +284,8 @@ def adjoint_columns(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray
         buf = np.empty((chunk, nr, Mx), dtype=work)
         for b in range(data.shape[0]):
             ar, ai = plan.gather(data[b], weights, work, workers)
-            for j0 in range(0, zs.size, chunk):
-                j1 = min(zs.size, j0 + chunk)
+            for j0 in range(0, zs_size, chunk):
+                j1 = min(zs_size, j0 + chunk)
                 m = j1 - j0
                 buf.fill(0)
                 _run(run, plan, ar, ai, j0, j1, zero, buf.view(real).reshape(chunk, -1))
@@ -349,14 +337,10 @@ class ColumnPlan:
                                       self.bend, self.rows, self.row_reach, self.pos))
 
     @classmethod
-    def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
-              z0: float, dz: float, nz: int, medium: Medium, mono: bool, incident: str,
-              point_area: float | None, pol: Any, direct: bool, work: np.dtype,
-              used: np.ndarray) -> ColumnPlan:
+    def build(cls, terms: TermsKey, direct: bool) -> ColumnPlan:
+        grid, work, ks = terms.grid, terms.work, terms.ks
         Mx = grid[1]
-        gain_q, step_q, jmax, unfold = kspace.frequency_terms(
-            grid, dx, dy, ks, z0, dz, nz, medium, mono, incident, work, used, TINY[work.char],
-            point_area, pol)
+        gain_q, step_q, jmax, unfold = kspace.frequency_terms(terms)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Deepest-reaching first (stable: grid order among equals), so that the blocks

@@ -27,102 +27,75 @@ the planes each term reaches, ``R_j`` the spectrum of image plane j.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from ...._lazy import lazy_module
 from ...._threads import fft_workers
-from ....physics.medium import Medium
 from ....physics.propagation import (
     TRANSFER_CACHE,
     inverse_kz,
     lateral_travel,
-    padded_shape,
     spectral_axes,
     spectral_quadrant,
     spectral_step,
     two_way_transfer,
 )
 from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
+from .terms import TINY, TermsKey
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
 _CHUNK = 8      # planes per inverse-FFT batch (memory: _CHUNK padded planes)
 _BLOCK = 2048   # spectral components per cache block of the recurrence
-_TINY = 1e-17   # a component below this fraction of its frequency's largest is dropped
 
 
-def band_grid(shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray, mono: bool,
-              pad: Any, z_max: float) -> tuple[int, int]:
-    """The FFT grid a band shares: sized for its longest wavelength (half of it for a
-    transceiver's round trip) and the deepest plane (:func:`padded_shape`)."""
-    lam = (0.5 if mono else 1.0) * 2 * np.pi / float(np.min(ks))
-    return padded_shape(shape, pad, pitch=pitch, wavelength=lam, z_max=z_max)
+def adjoint_kspace(data: np.ndarray, terms: TermsKey, weights: np.ndarray,
+                   upsample: int = 1) -> np.ndarray:
+    """The coherent image on the uniform planes of ``terms`` (see the module docstring).
 
-
-def adjoint_kspace(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
-                   zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
-                   pad: Any, upsample: int, work: np.dtype, incident: str,
-                   point_area: float | None = None,
-                   pol: tuple[float, float] | None = None) -> np.ndarray:
-    """The coherent image on uniform planes ``zs`` (see the module docstring).
-
-    ``data``: ``(B, nf, ny, nx)``; returns ``(B, nz, oy, ox)``. ``incident``: the
-    normal plane wave's factor a receiver array's frequencies are multiplied by
-    (``"phase"``: its unit phasor, ``"field"``: the field, ``"none"``).
+    ``data``: ``(B, nf, ny, nx)``; returns ``(B, nz, oy, ox)``; ``weights`` one per
+    frequency; ``upsample`` the output's pixels per pitch.
     """
-    dx, dy = pitch
     ny, nx = data.shape[-2:]
-    fft_shape = band_grid((ny, nx), pitch, ks, mono, pad, float(zs.max()))
-    workers = fft_workers(fft_shape[0] * fft_shape[1])
+    workers = fft_workers(terms.grid[0] * terms.grid[1])
     weights = np.asarray(weights, dtype=float)
-    key = ("kspace", fft_shape, dx, dy, tuple(float(k) for k in ks),
-           float(zs[0]), float(zs[1] - zs[0]), zs.size, medium, mono, incident, point_area,
-           pol, work.str, tuple(weights != 0))
-    plan = TRANSFER_CACHE.get(key, lambda: _Plan.build(*key[1:-2], work, np.asarray(key[-1])))
-    Hc = plan.gather(data, weights, work, workers)
+    plan = TRANSFER_CACHE.get(("kspace", terms), lambda: _Plan.build(terms))
+    Hc = plan.gather(data, weights, terms.work, workers)
     u = int(upsample)
     oy, ox = u * (ny - 1) + 1, u * (nx - 1) + 1
-    out = np.empty((data.shape[0], zs.size, oy, ox), dtype=work)
+    out = np.empty((data.shape[0], terms.nz, oy, ox), dtype=terms.work)
     plan.sum_planes(Hc, out, u, workers)
     return out
 
 
-def forward_kspace(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float, float],
-                   ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
-                   weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
-                   incident: str, tiny: float = _TINY,
-                   point_area: float | None = None,
-                   pol: tuple[float, float] | None = None) -> np.ndarray:
+def forward_kspace(image: np.ndarray, shape: tuple[int, int], terms: TermsKey,
+                   weights: np.ndarray, upsample: int = 1) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_kspace` (and of the compiled sum with its
-    ``tiny``): image ``(B, nz, oy, ox)`` -> samples ``(B, nf, ny, nx)``.
+    ``terms.tiny``): image ``(B, nz, oy, ox)`` -> samples ``(B, nf, ny, nx)``.
 
     Each image plane's spectrum (the adjoint of the cropped, interpolated inverse
     FFT) meets every frequency's terms: ``H_f += conj(w_f gain_f step_f^j) R_j`` while
     plane ``j`` is within the term's reach; one inverse FFT per frequency.
     """
-    dx, dy = pitch
     ny, nx = shape
-    grid = band_grid(shape, pitch, ks, mono, pad, float(zs.max()))
-    My, Mx = grid
+    My, Mx = terms.grid
+    work = terms.work
     workers = fft_workers(My * Mx)
     w = np.asarray(weights, dtype=float)
-    gain, step, jmax, unfold = frequency_terms(
-        grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), float(zs[1] - zs[0]),
-        zs.size, medium, mono, incident, work, w != 0, tiny, point_area, pol)
+    gain, step, jmax, unfold = frequency_terms(terms)
     # Conjugated, weighted and on the whole grid: the forward terms.
     cur = np.conj(gain[:, unfold]) * w[:, None].astype(work)
     back = np.conj(step[:, unfold])
     u = int(upsample)
     B = image.shape[0]
-    H = np.zeros((B, len(ks), My * Mx), dtype=work)
-    for j in range(zs.size):
+    H = np.zeros((B, terms.nf, My * Mx), dtype=work)
+    for j in range(terms.nz):
         R = fold(fft2_padded(image[:, j], (u * My, u * Mx), work, workers), u)
         live = jmax >= j
         H += np.where(live, cur, 0)[None] * R.reshape(B, 1, -1)
         cur *= back
-    return ifft2_cropped(H.reshape(B, len(ks), My, Mx), (ny, nx), workers, overwrite=True)
+    return ifft2_cropped(H.reshape(B, terms.nf, My, Mx), (ny, nx), workers, overwrite=True)
 
 
 @dataclass
@@ -158,15 +131,10 @@ class _Plan:
                                       *(a for pair in self.scatter for a in pair)))
 
     @classmethod
-    def build(cls, grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
-              z0: float, dz: float, nz: int, medium: Medium, mono: bool,
-              incident: str, point_area: float | None, pol: Any, work: np.dtype,
-              used: np.ndarray) -> _Plan:
+    def build(cls, terms: TermsKey) -> _Plan:
+        grid, nz, nf = terms.grid, terms.nz, terms.nf
         Mx = grid[1]
-        gain, step, jmax, unfold = frequency_terms(grid, dx, dy, ks, z0, dz, nz, medium, mono,
-                                                   incident, work, used,
-                                                   point_area=point_area, pol=pol)
-        nf = len(ks)
+        gain, step, jmax, unfold = frequency_terms(terms)
         reach = jmax.max(axis=0)
         live = np.flatnonzero(reach >= 0)
         # Live ones first, chunk of planes by chunk (a prefix for each chunk), in grid
@@ -262,37 +230,36 @@ class _Plan:
                                              u, workers)
 
 
-def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float, ...],
-                    z0: float, dz: float, nz: int, medium: Medium, mono: bool,
-                    incident: str, work: np.dtype, used: np.ndarray,
-                    tiny: float = _TINY, point_area: float | None = None,
-                    pol: tuple[float, float] | None = None
+def frequency_terms(terms: TermsKey
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per frequency, on one quadrant of the spectrum: the conjugate transfer to the
     first plane (a receiver array's: times the conjugate of a normal plane wave's
-    incident factor, ``incident`` "phase" ``E0/|E0|`` or "field" ``E0``, or "none";
-    with ``point_area``, a receiver array's voxels of that cell as point scatterers:
-    times ``conj(2 pi i/(kz dA))``, and with ``pol`` the vector model's dipole factor,
-    :mod:`holoradar.imaging.migration.units`),
-    the plane-to-plane step ``exp(-i conj(Kz) dz)``, and the last plane each component
-    of the full grid takes part in (-1: none; a frequency with ``used[i]`` False
-    takes part nowhere). ``tiny``: a term whose weight has fallen below this fraction of
-    its frequency's largest is dropped (see :func:`_last_planes`).
+    incident factor, ``terms.incident`` "phase" ``E0/|E0|`` or "field" ``E0``, or
+    "none"; with ``terms.point_area``, a receiver array's voxels of that cell as point
+    scatterers: times ``conj(2 pi i/(kz dA))``, and with ``terms.pol`` the vector
+    model's dipole factor, :mod:`holoradar.imaging.migration.units`), the
+    plane-to-plane step ``exp(-i conj(Kz) dz)``, and the last plane each component of
+    the full grid takes part in (-1: none; a frequency whose ``terms.used`` is False
+    takes part nowhere). A term whose weight has fallen below ``terms.tiny`` of its
+    frequency's largest is dropped (see :func:`_last_planes`).
 
     Returns ``(gain, step, jmax, unfold)``: ``gain`` and ``step`` of shape (nf, quadrant
-    size) in ``work``; ``jmax`` (nf, My * Mx) int32 on the full grid; ``unfold`` the
-    quadrant index of every grid component (:func:`spectral_quadrant`). Everything
+    size) in ``terms.work``; ``jmax`` (nf, My * Mx) int32 on the full grid; ``unfold``
+    the quadrant index of every grid component (:func:`spectral_quadrant`). Everything
     depends on ``|p|`` and ``|q|`` only: computed on one quadrant (four times less work
     for a cold start).
     """
+    grid, (dx, dy), medium, mono = terms.grid, terms.pitch, terms.medium, terms.mono
+    z0, dz, nz, incident = terms.z0, terms.dz, terms.nz, terms.incident
+    point_area, pol = terms.point_area, terms.pol
     p, q, kappa2, unfold = spectral_quadrant(grid, dx, dy)
     last = medium.n_regions - 1
     n_last = medium.n(last)
-    nf = len(ks)
+    nf = terms.nf
     shape = (nf, p.size * q.size)
-    gain, step = np.empty(shape, dtype=work), np.empty(shape, dtype=work)
+    gain, step = np.empty(shape, dtype=terms.work), np.empty(shape, dtype=terms.work)
     jmax = np.empty(shape, dtype=np.int32)
-    for i, k in enumerate(ks):
+    for i, k in enumerate(terms.ks):
         if mono:
             a = np.conj(two_way_transfer(k, medium, kappa2, z0))
             Kz = 2 * medium.kz(k, kappa2 / 4, last)
@@ -322,7 +289,7 @@ def frequency_terms(grid: tuple[int, int], dx: float, dy: float, ks: tuple[float
         gain[i], step[i] = a.ravel(), s.ravel()
         # The band limit at the first plane (jmax < 0) is the per-plane one.
         jmax[i] = _last_planes(a, s, evanescent, p, q, t0, rate, dz, grid, (dx, dy),
-                               nz, tiny).ravel() if used[i] else -1
+                               nz, terms.tiny).ravel() if terms.used[i] else -1
     return gain, step, jmax[:, unfold], unfold
 
 
@@ -335,12 +302,12 @@ def _small_int(top: int) -> type:
 def _last_planes(a: np.ndarray, step: np.ndarray, evanescent: np.ndarray, p: np.ndarray,
                  q: np.ndarray, t0: np.ndarray, rate: np.ndarray, dz: float,
                  grid: tuple[int, int], pitch: tuple[float, float], nz: int,
-                 tiny: float = _TINY) -> np.ndarray:
+                 tiny: float = TINY) -> np.ndarray:
     """The last plane index each component takes part in (-1: none, at most nz - 1).
 
     Band limit: the lateral shift ``|p| t(z)``, ``t(z) = t0 + (z - z0) rate``, must
     stay within half the grid (as in the per-plane transfer). Decay: a component
-    whose weight ``|a| |step|^j`` has fallen below ``tiny`` (default ``_TINY``) of the
+    whose weight ``|a| |step|^j`` has fallen below ``tiny`` (default :data:`.terms.TINY`) of the
     frequency's largest is zero to rounding (evanescent waves, absorption).
     """
     My, Mx = grid

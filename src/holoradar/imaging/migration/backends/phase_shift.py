@@ -19,6 +19,7 @@ from .. import illumination, units
 from ..plan import MigrationPlan
 from . import columns, kspace, stolt
 from .base import Backend, uniform_planes
+from .terms import TINY, TermsKey, band_weights
 
 __all__ = ["Columns", "PhaseShift", "Stolt"]
 
@@ -27,8 +28,6 @@ class PhaseShift(Backend):
     """The phase-shift sum in NumPy (the reference of the compiled loop)."""
 
     name = "kspace"
-    tiny = kspace._TINY
-
     def refuses(self, plan: MigrationPlan) -> str | None:
         why = self._needs(plan)
         return "; ".join(why) if why else None
@@ -69,26 +68,14 @@ class PhaseShift(Backend):
                        "across each plane)")
         return why
 
-    def _incident(self, plan: MigrationPlan) -> str:
-        return "none" if plan.monostatic else plan.illumination
+    def terms(self, plan: MigrationPlan) -> TermsKey:
+        """The key of the plan's terms (:meth:`.terms.TermsKey.of`), with this
+        backend's drop fraction."""
+        return TermsKey.of(plan).with_tiny(self.tiny(plan))
 
-    def _args(self, plan: MigrationPlan) -> tuple:
-        g = plan.geometry
-        weights = plan.weights
-        if units.is_point(plan) and plan.monostatic:
-            # The transceiver's point unit 2 pi i/(2 k n L dA) factors into a real weight
-            # per frequency, pi/(k dA), and a factor per plane, i/(n L) (_planes).
-            weights = weights * np.pi / (plan.wavenumbers * g.pitch[0] * g.pitch[1])
-        return (g.pitch, plan.wavenumbers, plan.z, plan.local, g.monostatic, weights)
-
-    def _options(self, plan: MigrationPlan) -> dict:
-        g = plan.geometry
-        point = units.is_point(plan) and not plan.monostatic
-        pol = units.polarization(plan) if units.is_point(plan) else None
-        return {"pad": plan.pad, "upsample": plan.settings.upsample, "work": plan.work,
-                "incident": self._incident(plan),
-                "point_area": g.pitch[0] * g.pitch[1] if point else None,
-                "pol": None if pol is None else (float(pol[0]), float(pol[1]))}
+    def tiny(self, plan: MigrationPlan) -> float:
+        """The fraction of a frequency's largest term below which a term is dropped."""
+        return TINY
 
     def _planes(self, plan: MigrationPlan) -> np.ndarray | None:
         """A transceiver's point unit's factor per plane, ``i/(n_m L)`` (None: 1)."""
@@ -109,11 +96,12 @@ class PhaseShift(Backend):
         return self._forward(plan, image if c is None else image * c)
 
     def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
-        return kspace.adjoint_kspace(data, *self._args(plan), **self._options(plan))
+        return kspace.adjoint_kspace(data, self.terms(plan), band_weights(plan),
+                                     plan.settings.upsample)
 
     def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
-        return kspace.forward_kspace(image, plan.grid, *self._args(plan),
-                                     **self._options(plan), tiny=self.tiny)
+        return kspace.forward_kspace(image, plan.grid, self.terms(plan), band_weights(plan),
+                                     plan.settings.upsample)
 
     def axes(self, plan: MigrationPlan) -> tuple[np.ndarray, np.ndarray]:
         g = plan.geometry
@@ -138,12 +126,12 @@ class Columns(PhaseShift):
             why.append("numba (not installed)")
         return "; ".join(why) if why else None
 
-    def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
-        return columns.adjoint_columns(data, *self._args(plan), **self._options(plan))
+    def tiny(self, plan: MigrationPlan) -> float:
+        return columns.TINY[plan.work.char]
 
-    def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
-        return kspace.forward_kspace(image, plan.grid, *self._args(plan),
-                                     **self._options(plan), tiny=columns.TINY[plan.work.char])
+    def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
+        return columns.adjoint_columns(data, self.terms(plan), band_weights(plan),
+                                       plan.settings.upsample)
 
 
 class Stolt(PhaseShift):
@@ -162,10 +150,12 @@ class Stolt(PhaseShift):
         return "; ".join(why) if why else None
 
     def _adjoint(self, plan: MigrationPlan, data: np.ndarray) -> np.ndarray:
-        return stolt.adjoint_stolt(data, *self._args(plan), **self._options(plan))
+        return stolt.adjoint_stolt(data, self.terms(plan), band_weights(plan),
+                                   plan.settings.upsample)
 
     def _forward(self, plan: MigrationPlan, image: np.ndarray) -> np.ndarray:
-        return stolt.forward_stolt(image, plan.grid, *self._args(plan), **self._options(plan))
+        return stolt.forward_stolt(image, plan.grid, self.terms(plan), band_weights(plan),
+                                   plan.settings.upsample)
 
     def method(self, plan: MigrationPlan) -> str:
         return "stolt"

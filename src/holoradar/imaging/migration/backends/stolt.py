@@ -43,9 +43,9 @@ import numpy as np
 
 from ...._lazy import lazy_module
 from ...._threads import fft_workers
-from ....physics.medium import Medium
 from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
 from . import kspace
+from .terms import TermsKey
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
@@ -77,17 +77,9 @@ class _Terms:
     M: int
 
     @classmethod
-    def build(cls, shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray,
-              zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, pad: Any,
-              work: np.dtype, incident: str, point_area: float | None = None,
-              pol: tuple[float, float] | None = None) -> _Terms:
-        dx, dy = pitch
-        grid = kspace.band_grid(shape, pitch, ks, mono, pad, float(zs.max()))
-        nz = zs.size
-        dz = float(zs[1] - zs[0])
-        gain_q, step_q, jmax, unfold = kspace.frequency_terms(
-            grid, dx, dy, tuple(float(k) for k in ks), float(zs[0]), dz, nz, medium, mono,
-            incident, work, np.asarray(weights) != 0, point_area=point_area, pol=pol)
+    def build(cls, terms: TermsKey) -> _Terms:
+        grid, nz = terms.grid, terms.nz
+        gain_q, step_q, jmax, unfold = kspace.frequency_terms(terms)
         live = np.flatnonzero((jmax >= 0).any(axis=0))
         q_idx = unfold[live]
         jm = jmax[:, live]
@@ -128,32 +120,24 @@ class _Terms:
         return (base + np.mod(self.m0[:, g] + shift, self.M)).ravel()
 
 
-def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
-                  zs: np.ndarray, medium: Medium, mono: bool, weights: np.ndarray, *,
-                  pad: Any, upsample: int, work: np.dtype, incident: str,
-                  point_area: float | None = None,
-                  pol: tuple[float, float] | None = None) -> np.ndarray:
-    """The coherent wideband image on uniform planes ``zs`` by Stolt's resampling.
+def adjoint_stolt(data: np.ndarray, terms: TermsKey, weights: np.ndarray,
+                  upsample: int = 1) -> np.ndarray:
+    """The coherent wideband image on the uniform planes of ``terms`` by Stolt's
+    resampling.
 
     Parameters
     ----------
     data : numpy.ndarray
         ``(B, nf, ny, nx)``: a transceiver's, or a receiver array's lit by a plane
         wave at normal incidence.
-    pitch : (dx, dy)
-        Element pitch, metres.
-    ks : numpy.ndarray
-        Wavenumbers in air, rad/m.
-    zs : numpy.ndarray
-        Uniformly spaced ranges, metres, in the medium's deepest region.
-    medium : Medium
-        The layers; lossless, or loss left uncompensated.
-    mono : bool
-        A scanned transceiver's round trip.
+    terms : TermsKey
+        The band, the planes (uniformly spaced, in the medium's deepest region), the
+        layers (lossless, or loss left uncompensated), the model's factors, the FFT
+        grid and the working dtype (:class:`.terms.TermsKey`).
     weights : numpy.ndarray
         One weight per frequency.
-    pad, upsample, work, incident
-        As in :func:`.kspace.adjoint_kspace`.
+    upsample : int
+        Output pixels per pitch, as in :func:`holoradar.migrate`.
 
     Returns
     -------
@@ -169,18 +153,18 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     every component is live at the first planes). ``"auto"`` stays within ~2x.
     """
     ny, nx = data.shape[-2:]
-    T = _Terms.build((ny, nx), pitch, ks, zs, medium, mono, weights, pad, work, incident,
-                     point_area, pol)
+    T = _Terms.build(terms)
+    work, nf = terms.work, terms.nf
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
-    nz, nc = zs.size, T.live.size
+    nz, nc = terms.nz, T.live.size
     w = np.asarray(weights, dtype=float)
     up = int(upsample)
     oy, ox = up * (ny - 1) + 1, up * (nx - 1) + 1
     out = np.empty((data.shape[0], nz, oy, ox), dtype=work)
     for b in range(data.shape[0]):
-        A = np.empty((len(ks), nc), dtype=np.complex128)
-        for i in range(len(ks)):
+        A = np.empty((nf, nc), dtype=np.complex128)
+        for i in range(nf):
             H = fft2_padded(data[b, i], T.grid, work, workers)
             A[i] = H.reshape(-1)[T.live] * T.gain[i] * w[i]
         # The spectra of all planes on the grid, filled column block by column block.
@@ -221,11 +205,8 @@ def adjoint_stolt(data: np.ndarray, pitch: tuple[float, float], ks: np.ndarray,
     return out
 
 
-def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float, float],
-                  ks: np.ndarray, zs: np.ndarray, medium: Medium, mono: bool,
-                  weights: np.ndarray, *, pad: Any, upsample: int, work: np.dtype,
-                  incident: str, point_area: float | None = None,
-                  pol: tuple[float, float] | None = None) -> np.ndarray:
+def forward_stolt(image: np.ndarray, shape: tuple[int, int], terms: TermsKey,
+                  weights: np.ndarray, upsample: int = 1) -> np.ndarray:
     """The exact adjoint of :func:`adjoint_stolt`: image ``(B, nz, oy, ox)`` -> samples
     ``(B, nf, ny, nx)``.
 
@@ -235,11 +216,11 @@ def forward_stolt(image: np.ndarray, shape: tuple[int, int], pitch: tuple[float,
     nodes with the conjugate weights); the rest's conjugate steps; the conjugate gains
     and weights; one inverse FFT per frequency.
     """
-    T = _Terms.build(shape, pitch, ks, zs, medium, mono, weights, pad, work, incident,
-                     point_area, pol)
+    T = _Terms.build(terms)
+    work = terms.work
     My, Mx = T.grid
     workers = fft_workers(My * Mx)
-    nz, nc, nf = zs.size, T.live.size, len(ks)
+    nz, nc, nf = terms.nz, T.live.size, terms.nf
     up = int(upsample)
     w = np.asarray(weights, dtype=float)
     out = np.empty((image.shape[0], nf, *shape), dtype=work)
