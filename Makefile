@@ -11,7 +11,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[test]'
 	@# The compiled wavenumber-domain loops (numba) built once here, not on a first call.
-	$(BIN)/python -c "from holoradar.imaging import columns; columns.warm()"
+	$(BIN)/python -c "from holoradar.imaging.migration.backends import columns; columns.warm()"
 	@touch $(STAMP)
 
 demo: $(STAMP)
@@ -61,7 +61,7 @@ PYTEST_PARALLEL := -n auto --dist loadfile
 # And numba's loop checked (rebuilt if its source changed) so that no worker compiles it.
 PYCACHE := PYTHONDONTWRITEBYTECODE=
 PREPARE := $(PYCACHE) $(BIN)/python -m compileall -q -j 0 src tests && \
-	$(PYCACHE) $(BIN)/python -c "from holoradar.imaging import columns; columns.warm()"
+	$(PYCACHE) $(BIN)/python -c "from holoradar.imaging.migration.backends import columns; columns.warm()"
 test: $(STAMP) browser cf-units
 	$(BIN)/ruff check src tests benchmarks examples
 	$(PREPARE)

@@ -13,7 +13,7 @@ import numpy as np
 from ._lazy import lazy_module
 from ._validate import as_real, check_frequency
 from .data.hologram import C0
-from .physics.medium import _check_eps
+from .physics.medium import check_eps
 from .physics.medium import fresnel as _interface_fresnel
 
 # Imported on first use (holoradar._lazy): `import holoradar` should cost little more
@@ -76,7 +76,7 @@ def refractive_index(eps: complex) -> complex:
     >>> refractive_index(9.0)
     (3+0j)
     """
-    n = complex(np.sqrt(_check_eps(eps, "eps")))
+    n = complex(np.sqrt(check_eps(eps, "eps")))
     return -n if n.imag < 0 else n
 
 

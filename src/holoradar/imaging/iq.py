@@ -165,13 +165,13 @@ def _without_direct_wave(hologram: Hologram) -> Hologram:
     and its conjugate (least squares, free complex amplitudes) treats the two
     conventions alike. Without a known point radiator the data stay as they are.
     """
-    from .glare._common import Radiator, _recorded, direct_wave
+    from .glare._common import Radiator, direct_wave, recorded_polarization
 
     src = hologram.source
     if hologram.monostatic or not isinstance(src, Radiator):  # a plane wave: no focus
         return hologram
     shape = hologram.data.shape
-    D = direct_wave(src, hologram.k, hologram.points, _recorded(hologram, src))
+    D = direct_wave(src, hologram.k, hologram.points, recorded_polarization(hologram, src))
     basis = np.stack([D, np.conj(D)], axis=1)
     d = hologram.data.reshape(-1, D.size).T
     coef, *_ = np.linalg.lstsq(basis, d, rcond=None)

@@ -29,7 +29,7 @@ from ..theory import lateral_resolution
 from .glare import FitWarning, direct_wave, suppress_surface
 from .migration.image import Migration
 from .migration.settings import MigrationSettings
-from .synthesis import _check_views
+from .synthesis import check_views
 
 __all__ = ["StreamImager"]
 
@@ -72,7 +72,7 @@ class StreamImager:
 
     def __init__(self, views: Sequence[Hologram], z: float, medium: Medium, *,
                  upsample: int = 4, suppress: bool = True) -> None:
-        views = _check_views(views)
+        views = check_views(views)
         if np.ndim(z) != 0:
             raise ValueError(f"z must be one range in metres (a frame images one plane), got "
                              f"{z!r}")

@@ -45,7 +45,7 @@ __all__ = ["align_phases", "synthesize"]
 Mode = Literal["coherent", "amplitude", "quasi-coherent"]
 
 
-def _check_views(holograms: Sequence[Hologram]) -> list[Hologram]:
+def check_views(holograms: Sequence[Hologram]) -> list[Hologram]:
     views = list(holograms) if not isinstance(holograms, Hologram) else [holograms]
     if len(views) == 0:
         raise ValueError("holograms must hold at least one Hologram")
@@ -176,7 +176,7 @@ def synthesize(holograms: Sequence[Hologram], z: float | Sequence[float], *,
     >>> [round(v, 3) for v in img.peak()[:2]]
     [0.0, 0.0]
     """
-    views = _check_views(holograms)
+    views = check_views(holograms)
     if mode not in ("coherent", "amplitude", "quasi-coherent"):
         raise ValueError(f"mode must be 'coherent', 'amplitude' or 'quasi-coherent', got "
                          f"{mode!r}")

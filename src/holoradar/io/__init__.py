@@ -140,7 +140,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     ((0.025, 0.025), 9900000000.0)
     """
     src = Path(path)
-    lay = _as_layout(layout)
+    lay = as_layout(layout)
     obj = None
     device = False
     used = lay          # the layout the file was read with (a sidecar's merged in)
@@ -150,7 +150,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             obj = read_direct(src)
         except Exception:  # not ours, or damaged: decided below
             obj = None
-        if obj is None and _is_holoradar_netcdf(src):
+        if obj is None and is_holoradar_netcdf(src):
             obj = _load_netcdf(src)  # ours but odd: the xarray reader names the problem
     if obj is None and lay is not None and lay.wide is not None:
         obj = _wide(src, lay)
@@ -246,7 +246,7 @@ def _npz_image(v: dict[str, np.ndarray], what: str) -> Image:
                  has_z_axis=bool(v.get("has_z_axis", np.array(True))))
 
 
-def _as_layout(layout: Any) -> Layout | None:
+def as_layout(layout: Any) -> Layout | None:
     if layout is None or isinstance(layout, Layout):
         return layout
     if isinstance(layout, str):
@@ -257,7 +257,7 @@ def _as_layout(layout: Any) -> Layout | None:
                      f"got {type(layout).__name__}")
 
 
-def _is_holoradar_netcdf(src: Path) -> bool:
+def is_holoradar_netcdf(src: Path) -> bool:
     """Whether a file is a holoradar NetCDF file (False for one h5py cannot open: the
     generic reader then reads a NetCDF-3 file or names the damage)."""
     import h5py

@@ -191,7 +191,7 @@ def check_ground_permittivity(eps: complex, name: str = "eps") -> complex:
     return complex(eps)
 
 
-def _check_eps(eps: complex, name: str) -> complex:
+def check_eps(eps: complex, name: str) -> complex:
     try:
         e = complex(eps)
     except (TypeError, ValueError):
@@ -238,7 +238,7 @@ class Medium:
                              f"(the aperture lies in air), got {self.z_interfaces}")
         if any(b <= a for a, b in itertools.pairwise(zi)):
             raise ValueError(f"z_interfaces must be strictly increasing, got {zi}")
-        eps = tuple(_check_eps(e, f"eps[{i}]") for i, e in enumerate(np.atleast_1d(self.eps)))
+        eps = tuple(check_eps(e, f"eps[{i}]") for i, e in enumerate(np.atleast_1d(self.eps)))
         if len(eps) != len(zi) + 1:
             raise ValueError(f"eps must hold one permittivity per region ({len(zi) + 1}), got "
                              f"{len(eps)}")
@@ -605,6 +605,21 @@ class Medium:
         if down:
             return air * self._field_in(st, region, z_far)
         return air * self._up_from(st, region, z_far)
+
+    def seen_from(self, height: float) -> Medium:
+        """The same layers seen from a level plane at world range ``height`` in the air:
+        every interface's range less ``height`` (metres), so that ranges from that
+        plane come out.
+
+        Examples
+        --------
+        >>> Medium.half_space(0.3, 4.0).seen_from(0.1).z_interfaces
+        (0.19999999999999998,)
+        """
+        if height == 0.0 or self.is_free_space:
+            return self
+        return Medium(tuple(z - height for z in self.z_interfaces), self.eps,
+                      self.polarization)
 
     def with_polarization(self, polarization: Polarization) -> Medium:
         """The same stack with the other Fresnel law (``"TE"`` or ``"TM"``).

@@ -253,7 +253,7 @@ def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
     return np.exp(loss0) * (1 + e) / (rel + e)
 
 
-class _TransferCache:
+class TransferCache:
     """Least-recently-used cache of transfer functions bounded in bytes, not entries.
 
     Re-migrating the same geometry (a survey, a benchmark, a GUI sweep) reuses them;
@@ -289,12 +289,12 @@ class _TransferCache:
 
 #: Transfer functions, spectral bases and the plans built from them, shared by every
 #: propagator and migration backend (least recently used out beyond 256 MiB).
-TRANSFER_CACHE = _TransferCache(256 * 2**20)
+TRANSFER_CACHE = TransferCache(256 * 2**20)
 
 _CACHES = [TRANSFER_CACHE]
 
 
-def register_cache(cache: _TransferCache) -> _TransferCache:
+def register_cache(cache: TransferCache) -> TransferCache:
     """Have :func:`clear_transfer_cache` free ``cache`` too (a module's own plans)."""
     _CACHES.append(cache)
     return cache
@@ -495,7 +495,7 @@ def _travel(b: _Basis, k: float, medium: Medium, z: float, deepest: bool,
         return lateral_travel(k, medium, b.kappa2, z)
 
 
-class _PlaneOperator(ABC):
+class PlaneOperator(ABC):
     """Shared pad / FFT / crop machinery of the propagators."""
 
     def __init__(self, shape: tuple[int, int], dx: float, dy: float, k: float,
@@ -587,7 +587,7 @@ class _PlaneOperator(ABC):
         return out
 
 
-class AngularSpectrum(_PlaneOperator):
+class AngularSpectrum(PlaneOperator):
     """Exact angular-spectrum propagator through a layered medium.
 
     Parameters
@@ -642,7 +642,7 @@ class AngularSpectrum(_PlaneOperator):
                                  self.monostatic)
 
 
-class Fresnel(_PlaneOperator):
+class Fresnel(PlaneOperator):
     """Paraxial Fresnel-Kirchhoff propagator (the paper's Eq. 3), sampled convolution.
 
     Same parameters as :class:`AngularSpectrum`. The kernel is sampled on the

@@ -58,6 +58,6 @@ def check_store(store: str | os.PathLike[str], given: list[Path]) -> tuple[Path,
 
 def layout_text(layout: Any) -> Any:
     """A layout as something every worker can be sent (checked here, once)."""
-    from ..io import _as_layout
+    from ..io import as_layout
 
-    return _as_layout(layout)
+    return as_layout(layout)

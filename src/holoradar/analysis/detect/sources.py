@@ -128,11 +128,9 @@ def level(holo: Any, medium: Any) -> tuple[Any, Any]:
 def from_array(medium: Any, height: float) -> Any:
     """The ground seen from an array at world height ``height`` (m; ``migrate``'s shift):
     interfaces at ranges from the array, so that depths below the surface come out."""
-    from ...imaging.migration.backends.oblique import _shifted
-
     if medium is None or height == 0.0:
         return medium
-    return _shifted(medium, height)
+    return medium.seen_from(height)
 
 
 def fit_hologram(img: Any, holo: Any, medium: Any, opts: Mapping[str, Any],

@@ -86,9 +86,9 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
 
     summary: dict[str, Any] = {"file": str(file), "bytes": file.stat().st_size}
     lines = [f"{file.name} ({file.stat().st_size} bytes)"]
-    from ...io import _is_holoradar_netcdf
+    from ...io import is_holoradar_netcdf
 
-    is_ours = file.suffix.lower() in (".nc", ".nc4") and _is_holoradar_netcdf(file)
+    is_ours = file.suffix.lower() in (".nc", ".nc4") and is_holoradar_netcdf(file)
     obj, reason = None, None
     try:
         obj = load(file, layout=layout, check=False)

@@ -79,8 +79,8 @@ def look_figure(session: ViewSession, s: ViewSettings) -> Any:
     page's colour scale, labelled in cm."""
     from matplotlib.figure import Figure
 
+    from ..._figures import edges as _edges
     from ...analysis.metrics import peak_position
-    from ..plotting import _edges
 
     img = session.image(s)
     vol = session.sweep(s)

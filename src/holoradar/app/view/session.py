@@ -166,10 +166,10 @@ class ViewSession:
                     self.names.append(p.name if n == 1 else f"{p.name}[{i}]")
         self.kind = "image" if self.volume is not None else "holograms"
         if len(self.views) > 1:  # one view needs no source: it is imaged alone
-            from ...imaging.synthesis import _check_views
+            from ...imaging.synthesis import check_views
 
             try:
-                _check_views(self.views)
+                check_views(self.views)
             except ValueError as exc:
                 raise ValueError(f"the files are not views of one scene: {exc}") from None
         self._caches()

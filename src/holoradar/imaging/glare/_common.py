@@ -17,7 +17,7 @@ from ...physics.sources import GaussianBeam, PointSource
 Radiator = PointSource | GaussianBeam | Dipole
 
 
-def _recorded(hologram: Hologram, src: object) -> np.ndarray | None:
+def recorded_polarization(hologram: Hologram, src: object) -> np.ndarray | None:
     """The recorded field component when the vector model applies, else None."""
     if hologram.polarization is not None and has_polarization(src):
         return np.asarray(hologram.polarization)

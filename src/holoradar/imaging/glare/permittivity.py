@@ -8,7 +8,7 @@ from ...data.hologram import Hologram
 from ...physics.dipole import Dipole
 from ...physics.medium import Medium
 from ...physics.sources import GaussianBeam, PointSource
-from ._common import _recorded, _require_direct_wave, direct_wave
+from ._common import _require_direct_wave, direct_wave, recorded_polarization
 from .suppress import suppress_surface
 
 __all__ = ["estimate_permittivity"]
@@ -47,6 +47,6 @@ def estimate_permittivity(hologram: Hologram, medium: Medium, source: Any = None
     src = source if source is not None else getattr(hologram, "source", None)
     if direct and isinstance(src, PointSource | GaussianBeam | Dipole):
         _require_direct_wave(direct_wave(src, hologram.k, hologram.points,
-                                          _recorded(hologram, src)), hologram.data)
+                                          recorded_polarization(hologram, src)), hologram.data)
     _, rep = suppress_surface(hologram, medium, source, "image_source", direct=direct)
     return rep.eps, rep.eps_std

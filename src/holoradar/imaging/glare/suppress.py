@@ -22,7 +22,7 @@ from ...physics.sources import GaussianBeam, PointSource
 from ...theory import lateral_resolution
 from ..migration.image import Migration
 from ..migration.settings import MigrationSettings
-from ._common import _joint_direct, _recorded, _require_direct_wave, direct_wave
+from ._common import _joint_direct, _require_direct_wave, direct_wave, recorded_polarization
 from .beams import _eps_from_gaussian, _fit_gaussian
 from .image_source import _fit_image_source
 
@@ -284,7 +284,7 @@ def suppress_surface(hologram: Hologram, medium: Medium, source: Any = None,
     predicted = mirror_local[:2]
     E_before = _mirror_image(op, data)
     xs, ys, peak_before = _find_spot(op, E_before, predicted, 3 * cell)
-    pol = _recorded(hologram, src)
+    pol = recorded_polarization(hologram, src)
     D = direct_wave(src, k, pts, pol) if direct else None
     h = data.ravel()
     if D is not None and method == "image_source":

@@ -208,8 +208,7 @@ def _local_medium(medium: Medium, pose: Any) -> Medium:
     if height >= medium.z_interfaces[0]:
         raise ValueError(f"hologram.pose puts the aperture at z = {height:.4g} m, "
                          f"at or below the ground surface ({medium.z_interfaces[0]} m)")
-    return Medium(tuple(z - height for z in medium.z_interfaces), medium.eps,
-                  medium.polarization)
+    return medium.seen_from(height)
 
 
 _ONE = np.ones(1)

@@ -108,12 +108,10 @@ class GroundNufft(GroundDirect):
         if plan.settings.frame != "ground":
             return "frame='ground'"
         g = plan.geometry
-        if not (oblique_sum._uniform(g.x) and oblique_sum._uniform(g.y)):
+        if not oblique_sum.uniform_elements(g):
             return "elements on a uniform grid (finufft's modes)"
         return None
 
     def prefer(self, plan: MigrationPlan) -> bool:
         """Whether the measured costs favour it over the direct sums (``"auto"``)."""
-        g = self.grids(plan)[0]
-        return oblique_sum.choose_route(g.grid, plan.geometry.pose,
-                                    plan.geometry.data.shape[-2:]) == "nufft"
+        return oblique_sum.preferred_route(plan.geometry, self.grids(plan)[0].grid) == "nufft"

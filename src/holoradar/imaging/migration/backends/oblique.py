@@ -187,7 +187,7 @@ def ground_setup(geometry: Hologram, k: float, zs: np.ndarray, medium: Medium, *
     xo.setflags(write=False)
     yo.setflags(write=False)
     return GroundGrid(xo, yo, grid, (dcx, dcy), (uy, ux), (my, mx), z_ref, rise, reach, gap,
-                      _shifted(medium, z_ref), float(k), mono,
+                      medium.seen_from(z_ref), float(k), mono,
                       fft_workers(grid[0] * grid[1] * ux * uy))
 
 
@@ -311,14 +311,6 @@ def _make_band_limit(grid: tuple[int, int], pitch: tuple[float, float], k: float
     mask = np.where(b.evanescent, w_ev, wx * wy).ravel()[b.unfold].reshape(grid)
     mask.setflags(write=False)
     return mask
-
-
-def _shifted(medium: Medium, z_ref: float) -> Medium:
-    """The medium seen from a reference plane at world range ``z_ref`` in the air."""
-    if z_ref == 0.0 or medium.is_free_space:
-        return medium
-    return Medium(tuple(z - z_ref for z in medium.z_interfaces), medium.eps,
-                  medium.polarization)
 
 
 def spectrum_on_plane(geometry: Hologram, data: np.ndarray, g: GroundGrid, work: np.dtype,

@@ -117,11 +117,21 @@ def sum_to_elements(geometry: Hologram, G: np.ndarray, kk: float, grid: tuple[in
 def _route(geometry: Hologram, grid: tuple[int, int], route: str) -> str:
     if route not in ("auto", "nufft", "direct"):
         raise ValueError(f"route must be 'auto', 'nufft' or 'direct', got {route!r}")
-    if route == "auto":
-        # finufft needs the elements on a uniform grid; the direct sums do not
-        return choose_route(grid, geometry.pose, geometry.data.shape[-2:]) \
-            if _uniform(geometry.x) and _uniform(geometry.y) else "direct"
-    return route
+    return preferred_route(geometry, grid) if route == "auto" else route
+
+
+def uniform_elements(geometry: Hologram) -> bool:
+    """Whether the elements lie on a uniform grid (finufft's modes need one)."""
+    return _uniform(geometry.x) and _uniform(geometry.y)
+
+
+def preferred_route(geometry: Hologram, grid: tuple[int, int]) -> str:
+    """The route ``"auto"`` takes, decided here only (the ground-frame backends ask it
+    too): finufft where the elements are on a uniform grid and the measured costs
+    favour it (:func:`choose_route`), else the direct sums."""
+    if not uniform_elements(geometry):
+        return "direct"
+    return choose_route(grid, geometry.pose, geometry.data.shape[-2:])
 
 
 def _remap(geometry: Hologram, kk: float, grid: tuple[int, int], pitch: tuple[float, float],

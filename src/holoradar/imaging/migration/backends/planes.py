@@ -29,7 +29,7 @@ import numpy as np
 from .... import _threads
 from ...._lazy import lazy_module
 from ...._threads import pool
-from ....physics.propagation import AngularSpectrum, Fresnel, _PlaneOperator
+from ....physics.propagation import AngularSpectrum, Fresnel, PlaneOperator
 from ....physics.spectra import fft2_padded, fold, ifft2_cropped, interpolate
 from .. import illumination, units
 from ..plan import MigrationPlan
@@ -49,7 +49,7 @@ class PlaneByPlane(Backend):
     """The exact angular spectrum, each frequency and plane on its own (the reference)."""
 
     name = "frequency"
-    propagator_class: type[_PlaneOperator] = AngularSpectrum
+    propagator_class: type[PlaneOperator] = AngularSpectrum
 
     def refuses(self, plan: MigrationPlan) -> str | None:
         if plan.settings.frame != "aperture":
@@ -61,7 +61,7 @@ class PlaneByPlane(Backend):
         return None
 
     # ------------------------------------------------------------------ geometry
-    def propagator(self, plan: MigrationPlan, i: int) -> _PlaneOperator:
+    def propagator(self, plan: MigrationPlan, i: int) -> PlaneOperator:
         """Frequency ``i``'s propagator onto the plan's planes (made once per plan; its
         transfer functions cached)."""
         key = ("propagator", self.name, i)
@@ -118,7 +118,7 @@ class PlaneByPlane(Backend):
         finally:
             bar.close()
 
-    def _per_frequency_adjoint(self, plan: MigrationPlan, ops: list[_PlaneOperator],
+    def _per_frequency_adjoint(self, plan: MigrationPlan, ops: list[PlaneOperator],
                                data: np.ndarray, bar: _Progress) -> np.ndarray:
         x, y = self.axes(plan)
         acc: np.ndarray | None = None
@@ -136,7 +136,7 @@ class PlaneByPlane(Backend):
                 acc = img if acc is None else acc + img
         return np.stack(parts, axis=1) if plan.separate else acc
 
-    def _summed_adjoint(self, plan: MigrationPlan, ops: list[_PlaneOperator],
+    def _summed_adjoint(self, plan: MigrationPlan, ops: list[PlaneOperator],
                         data: np.ndarray, bar: _Progress) -> np.ndarray:
         """The band's spectra summed per FFT grid before one inverse FFT per plane."""
         B, nz = data.shape[0], plan.z.size
@@ -165,7 +165,7 @@ class PlaneByPlane(Backend):
         assert out is not None
         return out
 
-    def effective(self, plan: MigrationPlan, ops: list[_PlaneOperator], i: int, *,
+    def effective(self, plan: MigrationPlan, ops: list[PlaneOperator], i: int, *,
                   forward: bool = False, fold: bool = True) -> list[np.ndarray]:
         """Frequency ``i``'s adjoint transfers (``forward``: their conjugates, the
         forward map's), one per plane, with the point unit's factor (``scatterer=
@@ -213,7 +213,7 @@ class PlaneByPlane(Backend):
             planes = ifft2_cropped(S, (oy, ox), workers, overwrite=True)
         return planes * (u * u) if u > 1 else planes
 
-    def _plane_images(self, plan: MigrationPlan, op: _PlaneOperator, d: np.ndarray,
+    def _plane_images(self, plan: MigrationPlan, op: PlaneOperator, d: np.ndarray,
                       bar: _Progress, transfers: list[np.ndarray] | None = None
                       ) -> np.ndarray:
         """One frequency's back-propagation ``(B, ny, nx) -> (B, nz, oy, ox)`` (by
@@ -320,7 +320,7 @@ class FresnelPlanes(PlaneByPlane):
         return None
 
 
-def _groups(ops: list[_PlaneOperator]) -> dict[tuple[int, int], list[int]]:
+def _groups(ops: list[PlaneOperator]) -> dict[tuple[int, int], list[int]]:
     """Frequencies by FFT grid (``pad=True`` sizes it by the wavelength: across a band
     one or two grids)."""
     groups: dict[tuple[int, int], list[int]] = {}
@@ -329,7 +329,7 @@ def _groups(ops: list[_PlaneOperator]) -> dict[tuple[int, int], list[int]]:
     return groups
 
 
-def _spectra_fit(ops: list[_PlaneOperator], frames: int, work: np.dtype) -> bool:
+def _spectra_fit(ops: list[PlaneOperator], frames: int, work: np.dtype) -> bool:
     """Whether a band's padded spectra may all be held at once (:data:`_SUM_BYTES`)."""
     return sum(math.prod(op.fft_shape) for op in ops) * frames * work.itemsize <= _SUM_BYTES
 

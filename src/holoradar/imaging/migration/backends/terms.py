@@ -40,8 +40,14 @@ def band_grid(shape: tuple[int, int], pitch: tuple[float, float], ks: np.ndarray
 
     Examples
     --------
-    >>> band_grid((16, 16), (0.01, 0.01), np.array([200.0]), True, True, 0.3)
+    A transceiver at 9.5 GHz (k = 200 rad/m, round-trip wavelength 1.57 cm) over 16 x
+    16 elements at 1 cm: twice the size would do for 5 cm, the deepest plane at 30 cm
+    needs ``lambda z / dx^2`` = 47 samples (the next fast size, 48):
+
+    >>> band_grid((16, 16), (0.01, 0.01), np.array([200.0]), True, True, 0.05)
     (32, 32)
+    >>> band_grid((16, 16), (0.01, 0.01), np.array([200.0]), True, True, 0.3)
+    (48, 48)
     """
     lam = (0.5 if mono else 1.0) * 2 * np.pi / float(np.min(ks))
     return padded_shape(shape, pad, pitch=pitch, wavelength=lam, z_max=z_max)
