@@ -200,6 +200,39 @@ def test_migrate_is_the_operators_adjoint(kind):
     assert out.data.shape == img.data.shape and np.array_equal(out.z, img.z)
 
 
+@pytest.mark.parametrize("kind", ["array", "transceiver"])
+def test_the_imaging_preset_makes_migrate_the_adjoint(kind):
+    # One word instead of three options: preset="imaging" is migrate's defaults, so the
+    # adjoint is migrate's image bit for bit; the default preset ("forward") is not (a
+    # lossy ground's compensation and the frequencies' weights differ).
+    h = _holo(kind)
+    medium = SAND if kind != "array" else LOSSY
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        img = hr.migrate(h, ZS, medium=medium, dtype=np.complex128, upsample=2)
+        A = hr.migration_operator(h, ZS, medium=medium, upsample=2, preset="imaging")
+        F = hr.migration_operator(h, ZS, medium=medium, upsample=2)
+    np.testing.assert_array_equal(A.H @ A.vector(h), img.data.ravel())
+    assert not np.allclose(F.H @ F.vector(h), img.data.ravel())
+
+
+def test_one_table_of_defaults():
+    # migrate's keyword defaults are MigrationSettings' own (the "imaging" preset adds
+    # nothing), and an unknown preset is refused by name.
+    import inspect
+
+    from holoradar.imaging.migration.settings import PRESETS
+
+    settings = hr.MigrationSettings()
+    for name, p in inspect.signature(hr.migrate).parameters.items():
+        if p.kind is p.KEYWORD_ONLY and hasattr(settings, name):
+            assert getattr(settings, name) == p.default or \
+                (p.default is None and getattr(settings, name) is None), name
+    assert PRESETS["imaging"] == {}
+    with pytest.raises(ValueError, match="preset must be"):
+        hr.migration_operator(_holo("array"), ZS, preset="migrate")
+
+
 @pytest.mark.parametrize(("medium", "source"), [
     (None, hr.PlaneWave()),
     (hr.Medium.half_space(0.2, 4 + 0.2j), hr.PlaneWave()),

@@ -20,7 +20,7 @@ from ...data.hologram import C0, Hologram, Image
 from ...physics.propagation import padded_shape
 from ..migration.linear import migration_operator
 from ..migration.memory import available_memory
-from ..migration.settings import MigrationSettings
+from ..migration.settings import MigrationSettings, preset_options
 from .columns import column_norms
 from .noise import noise_std
 from .solvers import FALSE_ALARM, least_squares, noise_threshold, sparse
@@ -176,8 +176,7 @@ def _check(hologram: Any, method: Any, max_iter: Any, need_source: bool = True) 
 
 def _options(hologram: Hologram, z: Any, given: dict[str, Any]) -> dict[str, Any]:
     """The operator's options: the physics, and a grid padded for an accurate model."""
-    opts = {"scatterer": "point", "illumination": "field", "compensate_loss": False,
-            "equalize": False, "progress": False, **given}
+    opts = {**preset_options("inversion"), **given}
     if given.get("frame", "aperture") == "aperture":
         opts.setdefault("band_limit", "smooth")
         if "pad" not in given:

@@ -28,17 +28,16 @@ from .backends.base import Backend
 from .choose import choose
 from .plan import MigrationPlan, make_plan, without_data
 from .sampling import decimate, fine_hologram, oversampling, zero_insert
-from .settings import MigrationSettings
+from .settings import MigrationSettings, preset_options
 
 __all__ = ["MigrationOperator", "migration_operator"]
 
 #: What the operator models unless told otherwise: the physics, not migrate's filter.
-OPERATOR_DEFAULTS = {"compensate_loss": False, "equalize": False, "illumination": "field"}
 
 
 def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
                        settings: MigrationSettings | None = None, sampling: str = "auto",
-                       **options: Any) -> MigrationOperator:
+                       preset: str = "forward", **options: Any) -> MigrationOperator:
     """The linear map from a reflectivity on the image grid to ``hologram``'s samples.
 
     Parameters
@@ -67,11 +66,15 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
         :func:`holoradar.migrate`'s options (``method``, ``pad``, ``upsample``,
         ``fov``, ``frame``, ``x``, ``y``, ``dtype``, ``combine`` ("coherent" or "none"),
         ``algorithm``, ``snr_db``), and ``illumination`` ("field", "phase" or
-        "none"), ``compensate_loss``, ``equalize``. Their defaults here describe the
-        physics: ``illumination="field"`` (the source's incident field), no loss
-        compensation, unit frequency weights. Give ``compensate_loss=True,
-        equalize=True, illumination=None`` for the operator whose adjoint is
-        ``migrate``'s image.
+        "none"), ``compensate_loss``, ``equalize``, over the ``preset``'s.
+    preset : {"forward", "imaging", "inversion"}
+        The defaults the options replace (one table for every part that images):
+        ``"forward"`` (default) the physics a hologram holds:
+        ``illumination="field"`` (the source's incident field), no loss
+        compensation, unit frequency weights; ``"imaging"`` :func:`holoradar.migrate`'s
+        own, so that ``A.H @ h`` is ``migrate``'s image; ``"inversion"`` the forward
+        model with point scatterers (:func:`holoradar.invert`'s). Ignored where
+        ``settings`` is given (they are complete).
 
     Returns
     -------
@@ -102,7 +105,7 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
     """
     given = dict(options)
     if settings is None:
-        given = {**{k: v for k, v in OPERATOR_DEFAULTS.items() if k not in given}, **given}
+        given = {**preset_options(preset), **given}
     s = MigrationSettings.of(settings, **given)
     if s.combine == "incoherent":
         raise ValueError("combine='incoherent' is not linear (the root sum of squares of "

@@ -16,8 +16,8 @@ import numpy as np
 
 from ..._validate import as_axis, as_real, uniform_step
 
-__all__ = ["ALGORITHMS", "ILLUMINATIONS", "MigrationSettings", "check_choice",
-           "check_upsample"]
+__all__ = ["ALGORITHMS", "ILLUMINATIONS", "PRESETS", "MigrationSettings", "check_choice",
+           "check_upsample", "preset_options"]
 
 #: ``algorithm=`` values: ``"auto"`` or a backend's name.
 ALGORITHMS = ("auto", "frequency", "kspace", "columns", "stolt", "fresnel", "ground-direct",
@@ -25,6 +25,26 @@ ALGORITHMS = ("auto", "frequency", "kspace", "columns", "stolt", "fresnel", "gro
 
 #: ``illumination=`` values: what the forward model multiplies a reflectivity by.
 ILLUMINATIONS = ("none", "phase", "field")
+
+#: The one table of defaults: what each purpose sets over :class:`MigrationSettings`'
+#: own field defaults (which are :func:`holoradar.migrate`'s).
+#:
+#: * ``"imaging"``: the image :func:`holoradar.migrate` makes (loss compensated,
+#:   frequencies equalised, a receiver array's incident phase divided out); the
+#:   adjoint of :func:`holoradar.migration_operator` with this preset is ``migrate``.
+#: * ``"forward"``: the physics a hologram holds (the source's incident field, no loss
+#:   compensation, unit frequency weights): :func:`holoradar.migration_operator`'s
+#:   default, the forward model of ``simulate``'s planar targets.
+#: * ``"inversion"``: the forward model with each voxel a point scatterer's Born
+#:   amplitude, no progress bar per application (:func:`holoradar.invert` adds, in the
+#:   aperture's frame, the smooth band limit and a grid padded 3x or more: an accurate
+#:   model for a solver).
+PRESETS: dict[str, dict[str, Any]] = {
+    "imaging": {},
+    "forward": {"compensate_loss": False, "equalize": False, "illumination": "field"},
+    "inversion": {"compensate_loss": False, "equalize": False, "illumination": "field",
+                  "scatterer": "point", "progress": False},
+}
 
 
 def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
@@ -235,6 +255,19 @@ class MigrationSettings:
         return replace(self, **changes)
 
     @classmethod
+    def preset(cls, name: str, **options: Any) -> MigrationSettings:
+        """The settings of a named purpose (:data:`PRESETS`), ``options`` over them.
+
+        Examples
+        --------
+        >>> MigrationSettings.preset("forward").illumination
+        'field'
+        >>> MigrationSettings.preset("imaging").compensate_loss   # migrate's
+        True
+        """
+        return cls.of(**{**preset_options(name), **options})
+
+    @classmethod
     def of(cls, settings: MigrationSettings | None = None, **options: Any) -> MigrationSettings:
         """``settings`` with ``options`` replacing its fields (or new settings from them).
 
@@ -256,3 +289,14 @@ class MigrationSettings:
             raise ValueError("settings must be a holoradar.MigrationSettings, got "
                              f"{type(settings).__name__}")
         return settings.replace(**options) if options else settings
+
+
+def preset_options(name: str) -> dict[str, Any]:
+    """The options a named purpose sets (:data:`PRESETS`), a copy.
+
+    Examples
+    --------
+    >>> sorted(preset_options("forward"))
+    ['compensate_loss', 'equalize', 'illumination']
+    """
+    return dict(PRESETS[check_choice(name, "preset", tuple(PRESETS))])
