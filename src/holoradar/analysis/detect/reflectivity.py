@@ -113,20 +113,19 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
     # admits, and halves the memory each of the solver's hundreds of steps moves.
     grid.setdefault("dtype", np.complex64)
 
-    def invert(sigma: float | None, steps: int | None) -> Any:
+    def invert(sigma: Any, steps: int | None) -> Any:
         return reflectivity(hologram, zs, medium=medium, method=method, progress=progress,
                             max_iter=steps,
                             false_alarm=p, need_source=False, noise=sigma, **grid)
 
-    from ...imaging.inversion.noise import noise_std
+    from ...imaging.inversion.noise import NoiseLevel, nearest_source, noise_std
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NoiseWarning)
-        _, how = noise_std(hologram, float(np.min(vol.z)), noise)
-    assumed = how.startswith("assumed")
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always", NoiseWarning)
-        res = invert(noise, (PROBE_ITER if assumed else MAX_ITER) if method == "sparse"
+        # Found once (its warning, if assumed, said once) and passed on as found.
+        level = NoiseLevel(*noise_std(hologram, nearest_source(planes, medium), noise))
+        assumed = level.how.startswith("assumed")
+        res = invert(level, (PROBE_ITER if assumed else MAX_ITER) if method == "sparse"
                      else (LSQR_PROBE_ITER if assumed else None))
     if assumed:
         # The noise could not be estimated and was assumed: what a first fit leaves of

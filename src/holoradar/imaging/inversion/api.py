@@ -9,7 +9,6 @@ wherever they lie.
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
 from typing import Any
@@ -22,7 +21,7 @@ from ..migration.linear import migration_operator
 from ..migration.memory import available_memory
 from ..migration.settings import MigrationSettings, preset_options
 from .columns import column_norms
-from .noise import noise_std
+from .noise import nearest_source, noise_std
 from .solvers import FALSE_ALARM, least_squares, noise_threshold, sparse
 
 __all__ = ["METHODS", "Reflectivity", "invert", "reflectivity"]
@@ -128,9 +127,7 @@ def reflectivity(hologram: Hologram, z: Any, *, medium: Any = None, method: str 
     A = migration_operator(hologram, z, medium=medium, **options)
     _check_memory(A, method)
     zs = A.plan.z
-    surface = medium.z_interfaces[0] if medium is not None and not medium.is_free_space \
-        else math.inf
-    sigma, how = noise_std(hologram, min(float(zs.min()), surface), noise)
+    sigma, how = noise_std(hologram, nearest_source(zs, medium), noise)
     d = A.vector(hologram).astype(A.dtype, copy=False)
     c = column_norms(A, _cell_px(A, hologram))
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -22,11 +23,41 @@ from ...data.hologram import Hologram
 from ...data.noise import estimate_snr
 from ...physics.propagation import DEFAULT_SNR_DB
 
-__all__ = ["NoiseWarning", "noise_std"]
+__all__ = ["NoiseLevel", "NoiseWarning", "nearest_source", "noise_std"]
 
 
 class NoiseWarning(UserWarning):
     """The receiver noise could not be estimated from the data and was assumed."""
+
+
+@dataclass(frozen=True)
+class NoiseLevel:
+    """A noise already found (:func:`noise_std`'s answer), passed on as ``noise=`` so
+    that one call estimates it once.
+
+    Examples
+    --------
+    >>> noise_std(None, 0.1, NoiseLevel(0.5, "assumed"))
+    (0.5, 'assumed')
+    """
+
+    sigma: float
+    how: str
+
+
+def nearest_source(zs: Any, medium: Any) -> float:
+    """The range, metres, beyond which every source of the field lies: the nearest
+    plane, or the ground's surface where that is nearer.
+
+    Examples
+    --------
+    >>> import holoradar as hr
+    >>> nearest_source([0.3, 0.4], hr.Medium.half_space(0.2, 4.0))
+    0.2
+    """
+    surface = medium.z_interfaces[0] if medium is not None and not medium.is_free_space \
+        else math.inf
+    return min(float(np.min(zs)), surface)
 
 
 def noise_std(hologram: Hologram, z_min: float, noise: Any) -> tuple[float, str]:
@@ -40,8 +71,9 @@ def noise_std(hologram: Hologram, z_min: float, noise: Any) -> tuple[float, str]
     z_min : float
         Range, metres, beyond which every source of the field lies (the nearest plane
         or the ground surface).
-    noise : float or None
-        The given standard deviation (> 0), or None to estimate it.
+    noise : float, NoiseLevel or None
+        The given standard deviation (> 0), a level found before (returned as it
+        is), or None to estimate it.
 
     Raises
     ------
@@ -57,6 +89,8 @@ def noise_std(hologram: Hologram, z_min: float, noise: Any) -> tuple[float, str]
     >>> how.startswith("estimated"), round(10 * np.log10(np.mean(abs(h.data)**2) / sigma**2))
     (True, 25)
     """
+    if isinstance(noise, NoiseLevel):
+        return noise.sigma, noise.how
     if noise is not None:
         try:
             sigma = float(noise)
