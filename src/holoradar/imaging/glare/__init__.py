@@ -32,12 +32,14 @@ pattern, known in shape) is fitted jointly, with a free complex amplitude, and
 removed too (``direct=True``). It would focus at the radiator's own range, which
 is usually the aperture plane or behind it, where no image can be formed.
 
-Layout: :mod:`.suppress` (:func:`suppress_surface`, the cut and background
-methods), :mod:`.beams` (the Gaussian-beam fit), :mod:`.image_source` (the
-exact reflected field and the permittivity fit), :mod:`.permittivity`
-(:func:`estimate_permittivity`), :mod:`.dominance` (:func:`glare_share`: whether
-an image's brightest point is the glare), ``_common`` (the direct wave, linear
-fits).
+Layout: :mod:`.suppress` (:func:`suppress_surface`: its checks, the background
+subtraction, the dispatch), :mod:`.spot` (the mirror plane and the glare's spot that
+every model method starts from), one module per method (:mod:`.cut`, :mod:`.beams`
+for the Gaussian beam, :mod:`.image_source` for the exact reflected field and the
+permittivity fit), :mod:`.report` (the report, the warning, a method's answer),
+:mod:`.permittivity` (:func:`estimate_permittivity`), :mod:`.dominance`
+(:func:`glare_share`: whether an image's brightest point is the glare), ``_common``
+(the direct wave, linear fits).
 """
 
 # direct_wave: imported by holoradar.imaging.stream (re-exported, private)

@@ -16,8 +16,10 @@ import numpy as np
 from ..._lazy import lazy_module
 from ...data.hologram import Hologram
 from ...physics.medium import Medium
-from ...physics.sources import PointSource
+from ...physics.sources import GaussianBeam, PointSource
 from ._common import _linear_fit
+from .report import GlareFit
+from .spot import MirrorSpot
 
 # Imported on first use (holoradar._lazy): `import holoradar` should cost little more
 # than numpy.
@@ -40,16 +42,17 @@ def _csp_beam(k: float, pts: np.ndarray, x: float, y: float, z: float, b: float,
     return np.exp(1j * k * Rc) / Rc
 
 
-def _fit_gaussian(k: float, pts: np.ndarray, h: np.ndarray, D: np.ndarray | None, xs: float,
-                  ys: float, z_m: float, cell: float, initial: dict[str, Any] | None,
+def _fit_gaussian(spot: MirrorSpot, initial: dict[str, Any] | None,
                   transform: Callable[[np.ndarray], np.ndarray] | None = None,
                   u: np.ndarray | None = None, b0: float | None = None):
     """Fit ``a*beam + d*D`` to the data, in the domain ``transform`` maps them to.
 
     ``transform`` is the windowed image of the mirror plane (the paper's choice:
     there the glare is a compact spot and buried objects are defocused); ``None``
-    fits on the elements themselves.
+    fits on the elements themselves (in the aperture's frame: ``spot.local``).
     """
+    k, pts, h, D = spot.k, spot.local, spot.h, spot.D
+    xs, ys, z_m, cell = spot.xs, spot.ys, spot.z_m, spot.cell
     scale = cell
     # The spot lies in the mirror plane by construction: its range is not fitted (a
     # free range lets the beam swallow a buried reflector's own, deeper, focus).
@@ -143,3 +146,36 @@ def _eps_from_gaussian(a: complex, b: float, ref: complex, src: PointSource,
     if excess(1.0 + 1e-9) >= 0 or excess(1e4) <= 0:
         return complex(V), complex(np.nan)
     return complex(V), complex(_opt.brentq(excess, 1.0 + 1e-9, 1e4, xtol=1e-10))
+
+
+def remove_gaussian(spot: MirrorSpot, fit_domain: str, initial: dict[str, Any] | None
+                    ) -> GlareFit:
+    """The ``"gaussian"`` method: the beam fitted at ``spot`` (on the elements, or in a
+    window of two resolution cells around the spot in the mirror plane) and removed.
+
+    Examples
+    --------
+    Through :func:`holoradar.suppress_surface` (the default method).
+    """
+    transform = None
+    if fit_domain == "mirror":
+        window = np.hypot(spot.op.x[None, :] - spot.xs,
+                          spot.op.y[:, None] - spot.ys) <= 2 * spot.cell
+
+        def transform(v: np.ndarray) -> np.ndarray:
+            return spot.image(v)[window]
+
+    u_beam, b0 = None, None
+    src, pose, k = spot.src, spot.hologram.pose, spot.k
+    if isinstance(src, GaussianBeam):
+        # The reflected beam's axis (the incident one mirrored), in the aperture's
+        # frame, and its waist: the fit starts from them and lets the waist vary.
+        d = src.direction * np.array([1.0, 1.0, -1.0])
+        u_beam = np.array([d @ pose.u, d @ pose.v, d @ pose.normal])
+        b0 = k * src.waist**2 / 2
+    glare, direct_part, dcoef, fit = _fit_gaussian(spot, initial, transform, u_beam, b0)
+    b = fit["b"]
+    report = {"mirror_position": spot.world(fit["x"], fit["y"], fit["z"]),
+              "amplitude": fit["a"], "phase": float(np.angle(fit["a"])),
+              "waist": float(np.sqrt(2 * b / k))}
+    return GlareFit(glare, direct_part, dcoef, fit["converged"], fit, report)

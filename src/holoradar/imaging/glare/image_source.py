@@ -8,7 +8,6 @@ estimate of its uncertainty under a spatially correlated residual
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -16,7 +15,9 @@ import numpy as np
 
 from ..._lazy import lazy_module
 from ...physics.medium import Medium
-from ...physics.sources import PointSource
+from ._common import _require_direct_wave
+from .report import GlareFit
+from .spot import MirrorSpot
 
 # Imported on first use (holoradar._lazy): `import holoradar` should cost little more
 # than numpy.
@@ -86,11 +87,8 @@ def _model_error_bound(fun: np.ndarray, jac: np.ndarray, shape: tuple[int, int]
     return float(d[0]), float(d[1])
 
 
-def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarray,
-                      h: np.ndarray, D: np.ndarray | None, ref: complex | None,
-                      initial: dict[str, Any] | None,
-                      transform: Callable[[np.ndarray], np.ndarray],
-                      pol: np.ndarray | None = None):
+def _fit_image_source(spot: MirrorSpot, medium: Medium, ref: complex | None,
+                      initial: dict[str, Any] | None):
     """Fit the ground's permittivity from the exact reflected field.
 
     The glare's strength relative to the radiator's fixes |V|: the radiator's
@@ -103,6 +101,11 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
     radiator reflected by the stack, its TE and TM waves each with their own
     coefficients (:func:`holoradar.physics.dyadic.reflected_dyadic`).
     """
+    k, src, pts, h, D, pol = spot.k, spot.src, spot.pts, spot.h, spot.D, spot.pol
+
+    def transform(v: np.ndarray) -> np.ndarray:
+        return v.reshape(spot.shape)
+
     eps0 = complex(initial["eps"]) if initial and "eps" in initial else complex(medium.eps[1])
 
     def glare_of(e: np.ndarray) -> np.ndarray:
@@ -147,3 +150,24 @@ def _fit_image_source(k: float, medium: Medium, src: PointSource, pts: np.ndarra
            "converged": bool(sol.success and explained > 0.5)}
     dcoef = None if D is None else a
     return a * G, (np.zeros_like(h) if D is None else a * D), dcoef, fit
+
+
+def remove_image_source(spot: MirrorSpot, medium: Medium, reference_amplitude: complex | None,
+                        initial: dict[str, Any] | None) -> GlareFit:
+    """The ``"image_source"`` method: the exact reflected field fitted (the ground's
+    permittivity and, with the direct wave as reference, the radiator's amplitude)
+    and removed.
+
+    Examples
+    --------
+    Through :func:`holoradar.suppress_surface` (``method="image_source"``) or
+    :func:`holoradar.estimate_permittivity`.
+    """
+    if spot.D is not None:
+        _require_direct_wave(spot.D, spot.h)
+    glare, direct_part, dcoef, fit = _fit_image_source(spot, medium, reference_amplitude,
+                                                       initial)
+    report = {"mirror_position": tuple(spot.src.mirror_position(medium)),
+              "amplitude": fit["a"], "phase": float(np.angle(fit["a"])),
+              "eps": fit["eps"], "eps_std": fit["eps_std"]}
+    return GlareFit(glare, direct_part, dcoef, fit["converged"], fit, report)
