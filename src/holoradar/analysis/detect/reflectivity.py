@@ -41,7 +41,7 @@ import numpy as np
 
 from ..._lazy import lazy_module
 from ...data.hologram import C0
-from ...imaging.inversion.noise import NoiseWarning
+from ...imaging.inversion.noise import NoiseLevel, NoiseWarning, nearest_source, noise_std
 from .errors import HologramFitError
 from .grid import Volume
 from .multiples import line_offset, split_multiples
@@ -118,29 +118,8 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
                             max_iter=steps,
                             false_alarm=p, need_source=False, noise=sigma, **grid)
 
-    from ...imaging.inversion.noise import NoiseLevel, nearest_source, noise_std
-
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always", NoiseWarning)
-        # Found once (its warning, if assumed, said once) and passed on as found.
-        level = NoiseLevel(*noise_std(hologram, nearest_source(planes, medium), noise))
-        assumed = level.how.startswith("assumed")
-        res = invert(level, (PROBE_ITER if assumed else MAX_ITER) if method == "sparse"
-                     else (LSQR_PROBE_ITER if assumed else None))
-    if assumed:
-        # The noise could not be estimated and was assumed: what a first fit leaves of
-        # the data, noise and the model's error together, is a noise no lower than the
-        # true one (fewer steps leave more: the probe errs high, towards missing a weak
-        # object rather than reporting the noise's pieces); the inversion again with it
-        # (a noise set too low is fitted, and spurious pieces follow).
-        step = res.image.history[0]
-        sigma = max(res.sigma, step["residual"] / math.sqrt(hologram.data.size))
-        res = res.again(sigma) if method == "sparse" else invert(sigma, None)
-        res.image.history[0]["noise"] = ("the residual of a first inversion with the "
-                                         "noise assumed 40 dB below the data's power")
-    for w in said:
-        if not issubclass(w.category, NoiseWarning):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    res = _invert_at_the_noise(invert, hologram, nearest_source(planes, medium), noise,
+                               method)
     r = res.image
     data = r.data if r.has_z_axis else r.data[None]
     c = res.column_norms.reshape(data.shape)
@@ -181,6 +160,33 @@ def detect_by_inversion(vol: Volume, hologram: Any, medium: Any, options: dict[s
                            **{f"of_{k}": float(rows[m["multiple_of"]][k])
                               for k in ("x", "y", "depth")}} for m in multiples]}
     return rows, meta
+
+
+def _invert_at_the_noise(invert: Any, hologram: Any, z_min: float, noise: Any,
+                         method: str) -> Any:
+    """The inversion at the receiver noise: given, estimated from the data (found once,
+    its warning said once, passed on as found), or, where it can only be assumed, what
+    a first fit leaves of the data: noise and the model's error together, a noise no
+    lower than the true one (fewer steps leave more: the probe errs high, towards
+    missing a weak object rather than reporting the noise's pieces), then the
+    inversion again with it (a noise set too low is fitted, and spurious pieces
+    follow). ``invert(noise, steps)`` runs the inversion."""
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", NoiseWarning)
+        level = NoiseLevel(*noise_std(hologram, z_min, noise))
+        assumed = level.how.startswith("assumed")
+        res = invert(level, (PROBE_ITER if assumed else MAX_ITER) if method == "sparse"
+                     else (LSQR_PROBE_ITER if assumed else None))
+    if assumed:
+        step = res.image.history[0]
+        sigma = max(res.sigma, step["residual"] / math.sqrt(hologram.data.size))
+        res = res.again(sigma) if method == "sparse" else invert(sigma, None)
+        res.image.history[0]["noise"] = ("the residual of a first inversion with the "
+                                         "noise assumed 40 dB below the data's power")
+    for w in said:
+        if not issubclass(w.category, NoiseWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return res
 
 
 def _check_same_frequencies(vol: Volume, hologram: Any) -> None:
