@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import as_axis
+from ..data.band import Band
 from ..data.hologram import frequency_axis
 from ..data.pose import IDENTITY, Pose
 
@@ -44,7 +45,7 @@ def check_device(device: Any) -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class RawFrames:
+class RawFrames(Band):
     """Raw I and Q of a receiver array, before any calibration.
 
     Parameters
@@ -106,16 +107,6 @@ class RawFrames:
         object.__setattr__(self, "device", check_device(device))
         object.__setattr__(self, "source", source)
         object.__setattr__(self, "pose", IDENTITY if pose is None else pose)
-
-    @property
-    def is_wideband(self) -> bool:
-        """True when ``frequency`` is an axis (data (..., nf, ny, nx))."""
-        return isinstance(self.frequency, np.ndarray)
-
-    @property
-    def frequencies(self) -> np.ndarray:
-        """The frequencies, Hz, 1-D (one element for a single frequency)."""
-        return np.atleast_1d(np.asarray(self.frequency, dtype=float))
 
     @property
     def element_shape(self) -> tuple[int, int]:

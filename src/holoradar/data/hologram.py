@@ -21,6 +21,7 @@ from .._validate import (
     check_frequency,
     uniform_step,
 )
+from .band import Band
 from .pose import IDENTITY, Pose
 from .tx_offset import as_tx_offset
 
@@ -31,7 +32,7 @@ C0 = 299_792_458.0
 
 
 @dataclass(frozen=True, eq=False)
-class Hologram:
+class Hologram(Band):
     """A complex field sampled on the aperture plane, at one or several frequencies.
 
     Parameters
@@ -160,21 +161,6 @@ class Hologram:
         vector model applies."""
         return self.polarization is not None and (self.monostatic
                                                   or has_polarization(self.source))
-
-    @property
-    def is_wideband(self) -> bool:
-        """True when ``frequency`` is an axis of frequencies (``data`` (..., nf, ny, nx))."""
-        return isinstance(self.frequency, np.ndarray)
-
-    @property
-    def frequencies(self) -> np.ndarray:
-        """The frequencies, Hz, as a 1-D array (one element for a single frequency)."""
-        return np.atleast_1d(np.asarray(self.frequency, dtype=float))
-
-    @property
-    def nf(self) -> int:
-        """Number of frequencies."""
-        return self.frequencies.size
 
     @property
     def wavenumbers(self) -> np.ndarray:
