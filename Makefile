@@ -63,7 +63,7 @@ PYCACHE := PYTHONDONTWRITEBYTECODE=
 PREPARE := $(PYCACHE) $(BIN)/python -m compileall -q -j 0 src tests && \
 	$(PYCACHE) $(BIN)/python -c "from holoradar.imaging.migration.backends import columns; columns.warm()"
 test: $(STAMP) browser cf-units
-	$(BIN)/ruff check src tests benchmarks examples
+	$(BIN)/ruff check src tests benchmarks examples tools
 	$(PREPARE)
 	$(PYCACHE) MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q $(PYTEST_PARALLEL)
 
@@ -77,7 +77,7 @@ screenshots: $(STAMP) browser
 	  -m "browser" tests/test_viewer_browser.py tests/test_report_browser.py
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples
+	$(BIN)/ruff check src tests benchmarks examples tools
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install -q -e '.[test,bench]'
