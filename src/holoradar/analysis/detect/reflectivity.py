@@ -40,8 +40,8 @@ from typing import Any
 import numpy as np
 
 from ..._lazy import lazy_module
-from ...data.hologram import C0
 from ...imaging.inversion.noise import NoiseLevel, NoiseWarning, nearest_source, noise_std
+from ...theory import resolution_cells
 from .errors import HologramFitError
 from .grid import Volume
 from .multiples import line_offset, split_multiples
@@ -252,21 +252,13 @@ def _grid(vol: Volume, hologram: Any, medium: Any, options: dict[str, Any]
 
 
 def _lateral_cell(hologram: Any, medium: Any, z: float) -> float:
-    """``lambda L / A`` at range ``z`` (the centre frequency; L apparent in the ground)."""
-    lam = C0 / float(np.mean(hologram.frequencies))
-    L = medium.apparent_distance(z) if medium is not None else z
-    return lam * L / max(min(hologram.aperture_size), 1e-9)
+    """``lambda L / A`` at range ``z`` (:func:`holoradar.theory.resolution_cells`)."""
+    return resolution_cells(hologram, medium, z)[0]
 
 
 def _range_cell(hologram: Any, medium: Any, z: float) -> float:
-    """The depth response: ``c / (2 B n)`` across a band, one frequency's
-    ``4.97 lambda (L / A)^2``."""
-    n = float(medium.n(int(medium.region_of(z))).real) if medium is not None else 1.0
-    f = hologram.frequencies
-    if f.size > 1:
-        return C0 / (2 * float(np.ptp(f)) * n)
-    L = medium.apparent_distance(z) if medium is not None else z
-    return 4.97 * C0 / float(f[0]) * (L / max(min(hologram.aperture_size), 1e-9)) ** 2
+    """The depth response at ``z`` (:func:`holoradar.theory.resolution_cells`)."""
+    return resolution_cells(hologram, medium, z)[1]
 
 
 def _objects(data: np.ndarray, keep: np.ndarray, r: Any, cell: float, rcell: float,

@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from ...data.hologram import C0
+from ...theory import range_resolution
 from .areas import _inside
 from .grid import Volume
 from .table import depth_interval
@@ -64,8 +64,10 @@ def range_cell(frequency: Any, eps: float) -> float:
     f = np.sort(np.atleast_1d(np.asarray(frequency, float)))
     if f.size < 2:
         return np.inf
+    # The band taken with one step more (each sample standing for its step): the
+    # range focus's width of the plane-by-plane search.
     bandwidth = (f[-1] - f[0]) * f.size / (f.size - 1)
-    return float(C0 / (2 * np.sqrt(max(eps, 1.0)) * bandwidth))
+    return range_resolution(bandwidth, max(eps, 1.0))
 
 
 PlaneSearch = Callable[[Volume, float], tuple[list[dict[str, Any]], Any, str]]

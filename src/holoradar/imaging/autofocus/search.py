@@ -19,6 +19,7 @@ from ..._lazy import lazy_module
 from ..._validate import AliasingWarning
 from ...data.hologram import C0, Hologram
 from ...physics.medium import Medium
+from ...theory import range_resolution
 from ..migrate import migrate
 from ..point_response import PointResponse
 from .progress import make_room
@@ -127,7 +128,7 @@ class Search:
         self.A = m.apparent_distance(z_a)
         zp = z_a
         if self.wideband:
-            res = C0 / (2 * self.band * np.sqrt(e_mid))
+            res = range_resolution(self.band, e_mid)
             zp, _ = self.pr.scan(e_mid, top, bottom, self.xy,
                                  samples=int(np.clip((d1 - d0) / (res / 3), 24, 240)))
         self.P = m.optical_path(zp).real

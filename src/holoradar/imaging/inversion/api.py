@@ -17,6 +17,7 @@ import numpy as np
 
 from ...data.hologram import C0, Hologram, Image
 from ...physics.propagation import padded_shape
+from ...theory import resolution_cells
 from ..migration.linear import migration_operator
 from ..migration.memory import available_memory
 from ..migration.settings import MigrationSettings, preset_options
@@ -191,9 +192,8 @@ def _options(hologram: Hologram, z: Any, given: dict[str, Any]) -> dict[str, Any
 
 def _cell_px(A: Any, hologram: Hologram) -> float:
     """A lateral resolution cell at the middle plane, in image pixels (lambda z / A)."""
-    lam = C0 / float(np.mean(hologram.frequencies))
-    width = min(hologram.aperture_size)
-    cell = lam * float(np.median(A.plan.z)) / max(width, 1e-9)
+    # The operator's ranges as they are (no apparent distance: its planes' own).
+    cell = resolution_cells(hologram, None, float(np.median(A.plan.z)))[0]
     pitch = float(abs(A.x[1] - A.x[0])) if A.x.size > 1 else hologram.pitch[0]
     return max(cell / pitch, 1.0)
 
