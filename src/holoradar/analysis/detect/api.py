@@ -9,7 +9,7 @@ import numpy as np
 
 from .clean import CleanResult, clean
 from .grid import Volume, as_volume
-from .table import COLUMNS, as_eps_interval, depth_interval
+from .table import COLUMNS, as_eps_interval, cramer_rao_factor, depth_of, detection_row
 
 __all__ = ["detect"]
 
@@ -255,22 +255,12 @@ def _rows(result: CleanResult, vol: Volume, model: Any, medium: Any,
         if not np.all(np.isfinite(std)) and getattr(model, "kind", "") in ("window",
                                                                        "aperture"):
             mu, nu = model.widths(pos[2])
-            snr_lin = amp2 / s2 if s2 > 0 else np.inf
-            # Cramer-Rao of a peak's position: 1/sqrt(2 SNR beta^2), beta^2 = mu^2/3.
-            k = np.sqrt(3 / (2 * snr_lin)) if snr_lin > 0 else np.inf
+            k = cramer_rao_factor(amp2 / s2 if s2 > 0 else np.inf)
             std = (k / mu, k / nu, np.nan)
-        depth = lo = hi = np.nan
-        if medium is not None and medium.z_interfaces:
-            z0 = float(medium.z_interfaces[0])
-            depth = pos[2] - z0
-            eps = float(np.real(medium.eps[int(medium.region_of(pos[2]))]))
-            lo, hi = depth_interval(depth, std[2], eps, interval, wideband)
-        rows.append({"kind": "point", "x": pos[0], "y": pos[1], "range": pos[2],
-                     "depth": depth, "depth_low": lo, "depth_high": hi,
-                     "length": 0.0, "width": 0.0, "azimuth_deg": np.nan,
-                     "amplitude_db": 20 * np.log10(max(abs(c.amplitude), 1e-300)),
-                     "snr_db": snr, "x_std": std[0], "y_std": std[1], "range_std": std[2],
-                     "x_start": np.nan, "y_start": np.nan, "x_end": np.nan, "y_end": np.nan,
-                     "spacing": np.nan,
-                     "model_error_db": 20 * np.log10(max(c.model_error, 1e-6))})
+        depth, lo, hi = depth_of(pos[2], std[2], medium, interval, wideband)
+        rows.append(detection_row(
+            "point", pos[0], pos[1], pos[2], depth=depth, depth_low=lo, depth_high=hi,
+            length=0.0, width=0.0, amplitude_db=20 * np.log10(max(abs(c.amplitude), 1e-300)),
+            snr_db=snr, x_std=std[0], y_std=std[1], range_std=std[2],
+            model_error_db=20 * np.log10(max(c.model_error, 1e-6))))
     return rows

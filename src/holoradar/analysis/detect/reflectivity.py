@@ -45,7 +45,7 @@ from ...theory import resolution_cells
 from .errors import HologramFitError
 from .grid import Volume
 from .multiples import line_offset, split_multiples
-from .table import depth_interval
+from .table import cramer_rao_factor, depth_of, detection_row
 
 ndimage = lazy_module("scipy.ndimage")
 
@@ -440,29 +440,24 @@ def _row(ob: dict[str, Any], sigma: float, medium: Any, interval: Any,
         "area" if min(length, width) > 2 * cell else "point"
     amp = abs(complex(np.sum(ob["vals"])))
     snr_lin = float(np.sum(ob["w"] * ob["c"] ** 2)) / sigma**2
-    k = math.sqrt(3 / (2 * snr_lin)) if snr_lin > 0 else math.inf
+    k = cramer_rao_factor(snr_lin)
     # The peak's spread at the object's SNR, and the grid's: a centroid of voxels a
     # pitch p apart is off by up to p / 2, a standard deviation of p / sqrt(12).
     grid = (ob["dx"] ** 2 / 12, ob["dx"] ** 2 / 12, ob.get("dz", 0.0) ** 2 / 12)
     std = tuple(math.sqrt(s**2 + g) for s, g in zip(
         (cell * k / math.pi, cell * k / math.pi,
          _range_cell(hologram, medium, cz) * k / math.pi), grid, strict=True))
-    depth = lo = hi = np.nan
-    if medium is not None and medium.z_interfaces:
-        depth = cz - float(medium.z_interfaces[0])
-        eps = float(np.real(medium.eps[int(medium.region_of(cz))]))
-        lo, hi = depth_interval(depth, std[2], eps, interval, hologram.nf > 1)
-    line = kind == "line"
-    row = {"kind": kind, "x": cx, "y": cy, "range": cz, "depth": depth, "depth_low": lo,
-           "depth_high": hi, "length": length if kind != "point" else 0.0,
-           "width": width if kind != "point" else 0.0,
-           "azimuth_deg": azimuth if kind != "point" else np.nan,
-           "amplitude_db": 20 * math.log10(max(amp, 1e-300)),
-           "snr_db": 10 * math.log10(snr_lin) if snr_lin > 0 else -np.inf,
-           "x_std": std[0], "y_std": std[1], "range_std": std[2],
-           "x_start": ends[0] if line else np.nan, "y_start": ends[1] if line else np.nan,
-           "x_end": ends[2] if line else np.nan, "y_end": ends[3] if line else np.nan,
-           "spacing": np.nan, "model_error_db": np.nan, "area": np.nan}
+    depth, lo, hi = depth_of(cz, std[2], medium, interval, hologram.nf > 1)
+    line, point = kind == "line", kind == "point"
+    row = detection_row(
+        kind, cx, cy, cz, depth=depth, depth_low=lo, depth_high=hi,
+        length=0.0 if point else length, width=0.0 if point else width,
+        azimuth_deg=np.nan if point else azimuth,
+        amplitude_db=20 * math.log10(max(amp, 1e-300)),
+        snr_db=10 * math.log10(snr_lin) if snr_lin > 0 else -np.inf,
+        x_std=std[0], y_std=std[1], range_std=std[2],
+        **(dict(zip(("x_start", "y_start", "x_end", "y_end"), ends, strict=True))
+           if line else {}))
     if kind == "area":
         row["outline"], row["area"] = _outline(ob)
     return row
@@ -529,7 +524,5 @@ def _refine_points(rows: list[dict[str, Any]], model: Any, medium: Any,
         # the voxels' sum at one frequency cancels along the long focus.
         row["amplitude_db"] = 20 * math.log10(max(float(np.mean(np.abs(ob["a"]))), 1e-300))
         if medium is not None and medium.z_interfaces:
-            row["depth"] = row["range"] - float(medium.z_interfaces[0])
-            eps = float(np.real(medium.eps[int(medium.region_of(row["range"]))]))
-            row["depth_low"], row["depth_high"] = depth_interval(
-                row["depth"], row["range_std"], eps, interval, wideband)
+            row["depth"], row["depth_low"], row["depth_high"] = depth_of(
+                row["range"], row["range_std"], medium, interval, wideband)

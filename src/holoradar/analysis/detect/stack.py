@@ -48,7 +48,7 @@ import numpy as np
 from ...theory import range_resolution
 from .areas import _inside
 from .grid import Volume
-from .table import depth_interval
+from .table import cramer_rao_factor, depth_of
 
 __all__ = ["detect_planes", "plane_rate", "range_cell"]
 
@@ -246,10 +246,9 @@ def _place(iz: int, row: dict[str, Any], vol: Volume, cz: float, medium: Any,
             z = float(np.interp(k + d, np.arange(vol.z.size), vol.z))
     out = dict(row)
     snr = 10 ** (row["snr_db"] / 10) if np.isfinite(row["snr_db"]) else np.inf
-    std = float(np.sqrt(3 / (2 * snr)) * cz / np.pi) if snr > 0 and np.isfinite(cz) else np.nan
+    std = cramer_rao_factor(snr) * cz / np.pi if snr > 0 and np.isfinite(cz) else np.nan
     out["range"], out["range_std"] = z, std
     if medium is not None and medium.z_interfaces:
-        depth = z - float(medium.z_interfaces[0])
-        lo, hi = depth_interval(depth, std, _eps_at(medium, z), interval, True)
-        out["depth"], out["depth_low"], out["depth_high"] = depth, lo, hi
+        out["depth"], out["depth_low"], out["depth_high"] = depth_of(z, std, medium,
+                                                                     interval, True)
     return out

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
-__all__ = ["COLUMNS", "as_eps_interval", "depth_interval"]
+__all__ = ["COLUMNS", "as_eps_interval", "cramer_rao_factor", "depth_interval", "depth_of",
+           "detection_row"]
 
 COLUMNS = ["kind", "x", "y", "range", "depth", "depth_low", "depth_high", "length", "width",
            "azimuth_deg", "amplitude_db", "snr_db", "x_std", "y_std", "range_std",
@@ -88,3 +90,60 @@ def depth_interval(depth: float, range_std: float, eps: float,
             f = np.sqrt(eps / e) if wideband else np.sqrt(e / eps)
             ends.append(depth * f)
     return float(min(ends) - s), float(max(ends) + s)
+
+
+def detection_row(kind: str, x: float, y: float, range_m: float, **columns: Any
+                  ) -> dict[str, Any]:
+    """One object's row: every column of :data:`COLUMNS` (NaN where not given), the
+    one place a row is made.
+
+    ``columns`` may also hold the extras some kinds carry (``outline``: an area's
+    polygon; ``components``: how many pieces were joined).
+
+    Examples
+    --------
+    >>> row = detection_row("point", 0.0, 0.1, 0.4, amplitude_db=-3.0)
+    >>> row["kind"], row["amplitude_db"], bool(np.isnan(row["snr_db"])), len(row)
+    ('point', -3.0, True, 22)
+    """
+    unknown = set(columns) - set(COLUMNS) - {"outline", "components"}
+    if unknown:
+        raise ValueError(f"not a column of the objects' table: {sorted(unknown)}")
+    row: dict[str, Any] = dict.fromkeys(COLUMNS, np.nan)
+    row.update(kind=kind, x=x, y=y, range=range_m, **columns)
+    return row
+
+
+def depth_of(range_m: float, range_std: float, medium: Any,
+             interval: tuple[float, float] | None, wideband: bool
+             ) -> tuple[float, float, float]:
+    """``(depth, low, high)``: the depth below the ground's surface of an object at
+    ``range_m`` and its bounds (:func:`depth_interval`, with the permittivity of the
+    layer it lies in); NaN without a ground.
+
+    Examples
+    --------
+    >>> import holoradar as hr
+    >>> [round(v, 4) for v in depth_of(0.5, 0.0, hr.Medium.half_space(0.4, 4.0),
+    ...                                (3.0, 5.0), False)]
+    [0.1, 0.0866, 0.1118]
+    """
+    if medium is None or not medium.z_interfaces:
+        return np.nan, np.nan, np.nan
+    depth = range_m - float(medium.z_interfaces[0])
+    eps = float(np.real(medium.eps[int(medium.region_of(range_m))]))
+    lo, hi = depth_interval(depth, range_std, eps, interval, wideband)
+    return depth, lo, hi
+
+
+def cramer_rao_factor(snr: float) -> float:
+    """``sqrt(3 / (2 SNR))``: a peak's position standard deviation in units of its
+    response's width over pi (Cramer-Rao for a peak of mean-square spectral width
+    ``beta^2 = mu^2 / 3``: ``1 / sqrt(2 SNR beta^2)``); infinite at SNR 0.
+
+    Examples
+    --------
+    >>> round(cramer_rao_factor(150.0), 4)
+    0.1
+    """
+    return math.sqrt(3 / (2 * snr)) if snr > 0 else math.inf
