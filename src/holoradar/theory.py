@@ -445,5 +445,5 @@ def resolution_cells(hologram: Any, medium: Any, z: float) -> tuple[float, float
     lateral = lateral_resolution(C0 / float(np.mean(f)), max(L, 1e-12), A)
     if f.size > 1:
         eps = complex(medium.eps[int(medium.region_of(z))]) if medium is not None else 1.0
-        return lateral, range_resolution(float(np.ptp(f)), eps)
+        return lateral, float(range_resolution(float(np.ptp(f)), eps))
     return lateral, 4.97 * C0 / float(f[0]) * (L / A) ** 2

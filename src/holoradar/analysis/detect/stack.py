@@ -67,7 +67,7 @@ def range_cell(frequency: Any, eps: float) -> float:
     # The band taken with one step more (each sample standing for its step): the
     # range focus's width of the plane-by-plane search.
     bandwidth = (f[-1] - f[0]) * f.size / (f.size - 1)
-    return range_resolution(bandwidth, max(eps, 1.0))
+    return float(range_resolution(bandwidth, max(eps, 1.0)))
 
 
 PlaneSearch = Callable[[Volume, float], tuple[list[dict[str, Any]], Any, str]]
