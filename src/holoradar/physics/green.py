@@ -35,9 +35,9 @@ from typing import Literal
 import numpy as np
 
 from .._lazy import lazy_module
+from ..caches import named_cache
 from .conductor import refuse_perfect_conductor, surface_is_perfect_conductor
 from .medium import Medium
-from .propagation import TransferCache
 
 # Imported on first use (holoradar._lazy): scipy.special and scipy.interpolate cost more
 # than numpy's own import, and `import holoradar` should cost little more than numpy.
@@ -315,7 +315,7 @@ def _reflected(k: float, medium: Medium, rho: np.ndarray, air_path: np.ndarray) 
     return out
 
 
-_J0_CACHE = TransferCache(128 * 2**20)
+_J0_CACHE = named_cache("Bessel tables", max_bytes=128 * 2**20)
 
 
 def _bessel_matrix(rho: np.ndarray, kappa: np.ndarray) -> np.ndarray:

@@ -22,16 +22,15 @@ at least twice each size) keeps the periodic FFT from wrapping the image.
 
 from __future__ import annotations
 
-import threading
 from abc import ABC, abstractmethod
-from collections import OrderedDict
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._lazy import lazy_module
 from .._threads import fft_workers
+from ..caches import clear_caches, named_cache
 from .medium import FREE_SPACE, Medium
 from .spectra import fft2_padded, ifft2_cropped
 
@@ -253,58 +252,15 @@ def absorption_gain(k: float, medium: Medium, kappa2: np.ndarray, z: float,
     return np.exp(loss0) * (1 + e) / (rel + e)
 
 
-class TransferCache:
-    """Least-recently-used cache of transfer functions bounded in bytes, not entries.
-
-    Re-migrating the same geometry (a survey, a benchmark, a GUI sweep) reuses them;
-    the bound keeps a large volume from pinning gigabytes after it is done.
-    """
-
-    def __init__(self, max_bytes: int) -> None:
-        self.max_bytes = max_bytes
-        self._data: OrderedDict[tuple, np.ndarray] = OrderedDict()
-        self._bytes = 0
-        self._lock = threading.Lock()
-
-    def get(self, key: tuple, make: Callable[[], np.ndarray]) -> np.ndarray:
-        with self._lock:
-            if key in self._data:
-                self._data.move_to_end(key)
-                return self._data[key]
-        value = make()
-        with self._lock:
-            if key not in self._data and value.nbytes <= self.max_bytes:
-                self._data[key] = value
-                self._bytes += value.nbytes
-                while self._bytes > self.max_bytes:
-                    _, old = self._data.popitem(last=False)
-                    self._bytes -= old.nbytes
-        return value
-
-    def clear(self) -> None:
-        with self._lock:
-            self._data.clear()
-            self._bytes = 0
-
-
 #: Transfer functions, spectral bases and the plans built from them, shared by every
 #: propagator and migration backend (least recently used out beyond 256 MiB).
-TRANSFER_CACHE = TransferCache(256 * 2**20)
-
-_CACHES = [TRANSFER_CACHE]
-
-
-def register_cache(cache: TransferCache) -> TransferCache:
-    """Have :func:`clear_transfer_cache` free ``cache`` too (a module's own plans)."""
-    _CACHES.append(cache)
-    return cache
+TRANSFER_CACHE = named_cache("transfer functions", max_bytes=256 * 2**20)
 
 
 def clear_transfer_cache() -> None:
-    """Free the cached transfer functions (at most 256 MiB are kept) and the wideband
-    sum's plans (:data:`holoradar.imaging.migration.backends.columns.PLAN_CACHE`)."""
-    for cache in _CACHES:
-        cache.clear()
+    """Free what is kept between calls: the transfer functions (at most 256 MiB), the
+    wideband sum's plans and every other named cache (:func:`holoradar.caches.clear_caches`)."""
+    clear_caches()
 
 
 def transfer_cache_bytes() -> int:

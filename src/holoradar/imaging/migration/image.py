@@ -12,13 +12,12 @@ separate images.
 
 from __future__ import annotations
 
-import threading
 import weakref
-from collections import OrderedDict
 from typing import Any
 
 import numpy as np
 
+from ...caches import named_cache
 from ...data.hologram import Hologram, Image
 from .choose import choose
 from .memory import check_fits
@@ -137,10 +136,10 @@ def image_of(hologram: Hologram, z: Any, medium: Any, settings: MigrationSetting
     return img
 
 
-_RECENT: OrderedDict[tuple, tuple[Any, Migration]] = OrderedDict()
-_RECENT_SIZE = 4
+#: The last few migrations (their hologram held weakly), for the next call on the same
+#: data, planes, ground and settings.
+_RECENT = named_cache("recent migrations", max_entries=4)
 _RECENT_MEMO_BYTES = 1 << 24   # a plan that keeps more (illumination phasors) is not kept
-_LOCK = threading.Lock()
 
 
 def _key(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -> tuple | None:
@@ -158,13 +157,8 @@ def _key(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -> tup
 
 def _recent(hologram: Any, z: Any, medium: Any, settings: MigrationSettings) -> Migration:
     key = _key(hologram, z, medium, settings)
-    with _LOCK:
-        hit = _RECENT.get(key) if key is not None else None
-        if hit is not None and hit[0]() is hologram:
-            _RECENT.move_to_end(key)
-            m = hit[1]
-        else:
-            m = None
+    hit = _RECENT.lookup(key) if key is not None else None
+    m = hit[1] if hit is not None and hit[0]() is hologram else None
     if m is None:
         return Migration(hologram, z, medium, settings)
     warn(hologram, m.settings, m.plan.illumination)
@@ -177,8 +171,4 @@ def _keep(hologram: Any, z: Any, medium: Any, settings: MigrationSettings,
     kept = sum(getattr(v, "nbytes", 0) for v in m.plan.memo.values())
     if key is None or kept > _RECENT_MEMO_BYTES:
         return
-    with _LOCK:
-        _RECENT[key] = (weakref.ref(hologram), m)
-        _RECENT.move_to_end(key)
-        while len(_RECENT) > _RECENT_SIZE:
-            _RECENT.popitem(last=False)
+    _RECENT.put(key, (weakref.ref(hologram), m), replace=True)

@@ -38,7 +38,7 @@ import numpy as np
 from .... import _threads
 from ...._lazy import lazy_module
 from ...._threads import fft_workers, pool
-from ....physics.propagation import TransferCache, register_cache
+from ....caches import named_cache
 from ....physics.spectra import interpolate
 from . import kspace
 from . import terms as terms_mod
@@ -71,9 +71,8 @@ def _plan_budget() -> int:
 
 
 #: The compiled sum's plans (one per geometry, band and planes), least recently used
-#: out beyond :func:`_plan_budget`; :func:`~holoradar.physics.propagation.clear_transfer_cache`
-#: frees them.
-PLAN_CACHE = register_cache(TransferCache(_plan_budget()))
+#: out beyond :func:`_plan_budget`; :func:`holoradar.caches.clear_caches` frees them.
+PLAN_CACHE = named_cache("column plans", max_bytes=_plan_budget())
 
 
 def available() -> bool:
