@@ -94,3 +94,24 @@ def test_public_names_are_imported_on_first_use_and_all_resolve():
         print(early, ok, missing)
         """)], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["[]", "True", "[]"], out.stdout
+
+
+def test_the_public_names_agree_in_the_three_places_they_are_written():
+    # __all__ (what ruff and `import *` read), the lazy table (what resolves a name)
+    # and the TYPE_CHECKING imports (what static checkers and IDEs see) must name the
+    # same things: a name added to one only is a name some user cannot reach.
+    import ast
+    from pathlib import Path
+
+    import holoradar as hr
+
+    init = Path(hr.__file__)
+    tree = ast.parse(init.read_text())
+    static = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING":
+            for imp in ast.walk(node):
+                if isinstance(imp, ast.ImportFrom):
+                    static |= {a.asname or a.name for a in imp.names}
+    lazy = set(hr._NAMES) | set(hr._SUBMODULES)
+    assert static == lazy == set(hr.__all__), (static ^ lazy, lazy ^ set(hr.__all__))
