@@ -23,6 +23,8 @@ Part 2, this tree only: ``matvec`` + ``rmatvec`` of ``hr.migration_operator`` on
 
 Run: ``.venv/bin/python benchmarks/bench_operator.py [case ...] [--rounds N]``; merges
 the cases run into ``benchmarks/results_operator.json`` and prints a Markdown table.
+``--before REV`` compares with another commit instead (a restructuring's before and
+after in one run; written to ``results_operator_vs_REV.json``).
 """
 
 from __future__ import annotations
@@ -168,18 +170,18 @@ def _run(case: str, src: Path, pairs: int) -> dict:
     return json.loads(out.strip().splitlines()[-1])
 
 
-def _export_before(where: Path) -> Path:
-    blob = subprocess.run(["git", "-C", str(ROOT), "archive", BEFORE, "src"], check=True,
+def _export_before(where: Path, rev: str = BEFORE) -> Path:
+    blob = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src"], check=True,
                           capture_output=True).stdout
     with tarfile.open(fileobj=BytesIO(blob)) as tar:
         tar.extractall(where, filter="data")
     return where / "src"
 
 
-def main(rounds: int, cases: tuple[str, ...] = CASES) -> dict:
-    res: dict = {"before": BEFORE, "load": os.getloadavg()[0]}
+def main(rounds: int, cases: tuple[str, ...] = CASES, before: str = BEFORE) -> dict:
+    res: dict = {"before": before, "load": os.getloadavg()[0]}
     with tempfile.TemporaryDirectory() as tmp:
-        old = _export_before(Path(tmp))
+        old = _export_before(Path(tmp), before)
         new = ROOT / "src"
         for case in cases:
             pairs = 3 if case in ("wideband", "volume") else 15
@@ -208,9 +210,11 @@ if __name__ == "__main__":
         child(sys.argv[2], int(sys.argv[3]))
         sys.exit(0)
     n = int(sys.argv[sys.argv.index("--rounds") + 1]) if "--rounds" in sys.argv else 3
+    rev = sys.argv[sys.argv.index("--before") + 1] if "--before" in sys.argv else BEFORE
     chosen = tuple(a for a in sys.argv[1:] if a in CASES) or CASES
-    results = main(n, chosen)
-    out = Path(__file__).with_name("results_operator.json")
+    results = main(n, chosen, rev)
+    out = Path(__file__).with_name("results_operator.json" if rev == BEFORE else
+                                   f"results_operator_vs_{rev}.json")
     merged = json.loads(out.read_text()) if out.exists() else {}
     merged.update(results)   # the cases run replace theirs
     tmp = out.with_suffix(".json.tmp")
