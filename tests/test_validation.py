@@ -72,7 +72,7 @@ def test_gain_medium_refused():
 
 
 def test_bad_medium_geometry():
-    with pytest.raises(ValueError, match="z_interfaces must be finite ranges > 0"):
+    with pytest.raises(ValueError, match="z_interfaces must be finite ranges >= 0"):
         hr.Medium.half_space(-0.1, 2.5)
     with pytest.raises(ValueError, match="strictly increasing"):
         hr.Medium.layered([0.4, 0.3], [2.5, 4.0])

@@ -43,8 +43,11 @@ class Hologram(Band):
         time) processed together.
     x : array_like, shape (nx,)
         Element x coordinates, metres, strictly increasing.
-    y : array_like, shape (ny,)
-        Element y coordinates, metres, strictly increasing.
+    y : array_like, shape (ny,), optional
+        Element y coordinates, metres, strictly increasing. None (default): a line
+        scan (a B-scan) along x, ``data`` (..., nx) or (..., nf, nx), kept as one row
+        at y = 0; it images into an x-z section (the exact 2-D migration: targets
+        that do not vary along y, bars and pipes across the line).
     frequency : float or array_like of shape (nf,)
         Frequency in Hz (> 0), or nf strictly increasing frequencies (a wideband
         hologram; ``data.shape[-3] == nf``).
@@ -103,11 +106,21 @@ class Hologram(Band):
     polarization: np.ndarray | None = None
     tx_offset: tuple[float, float, float] | None = None
 
-    def __init__(self, data: Any, x: Any, y: Any, frequency: Any, *,
+    def __init__(self, data: Any, x: Any, y: Any = None, frequency: Any = None, *,
                  source: Any = None, monostatic: bool = False,
                  pose: Pose | None = None, polarization: Any = None,
                  tx_offset: Any = None) -> None:
-        arr = as_finite_complex(data, "data", min_ndim=2)
+        if frequency is None:
+            raise ValueError("frequency is needed: a number in Hz, or the band's "
+                             "frequencies (Hologram(data, x, y, frequency) or, for a line "
+                             "scan, Hologram(data, x, frequency=f))")
+        if y is None:
+            # A line scan (a B-scan): samples along x only, (..., [nf,] nx); kept as one
+            # row at y = 0 (data (..., [nf,] 1, nx)).
+            arr = as_finite_complex(data, "data", min_ndim=1)
+            arr, y = arr[..., None, :], np.zeros(1)
+        else:
+            arr = as_finite_complex(data, "data", min_ndim=2)
         # A reversed axis, or one rounded to a text export's digits: made increasing
         # and uniform, said once (data/grid_axes.py).
         x, arr = _regular(x, arr, "x", -1)
@@ -215,7 +228,15 @@ class Hologram(Band):
 
         Computed once (the axes are read-only), not at every migration.
         """
-        return uniform_step(self.x, "x"), uniform_step(self.y, "y")
+        dx = uniform_step(self.x, "x")
+        # A line scan's row stands for a strip one pitch wide (its y step taken as x's):
+        # the wave fields it images do not vary along y (the 2-D case).
+        return dx, (dx if self.is_line else uniform_step(self.y, "y"))
+
+    @property
+    def is_line(self) -> bool:
+        """True for a line scan (a B-scan): one row of samples along x."""
+        return self.y.size == 1
 
     @property
     def aperture_size(self) -> tuple[float, float]:

@@ -6,7 +6,10 @@ A device whose Q has the other sign (the engineering convention ``exp(+j*omega*t
 two are told apart by physics: with the right sign the scene focuses in front of
 the aperture; the conjugate is the field of the mirror scene behind it, so
 back-propagated to the same ranges it spreads out instead. The image with the
-sharper focus (larger peak-to-mean intensity) wins.
+sharper focus (larger peak-to-mean intensity) wins. What is the same at every position
+of a scanned transceiver (its coupling, the flat surface's echo) and a receiver
+array's direct wave are taken out first: they are not compact, and either convention
+may put them in front.
 
 :func:`iq_convention` always answers; :func:`check_iq_sign` answers only when the
 difference is decisive (otherwise ``None``), cheaply (a few planes and
@@ -144,7 +147,7 @@ def _band_sides(hologram: Hologram, zs: np.ndarray, opts: dict[str, Any]) -> lis
     frequencies weighted alike, ``equalize=True``): a point focuses in range too, so
     data each of whose frequencies is too faint to decide alone may decide together
     (the coherent sum's gain, ``10 log10(nf)`` dB over one frequency)."""
-    band = _reduced_band(hologram)
+    band = _without_scan_mean(_reduced_band(hologram))
     out = []
     for flip in (False, True):
         with warnings.catch_warnings():
@@ -176,6 +179,23 @@ def _without_direct_wave(hologram: Hologram) -> Hologram:
     d = hologram.data.reshape(-1, D.size).T
     coef, *_ = np.linalg.lstsq(basis, d, rcond=None)
     return hologram.with_data((d - basis @ coef).T.reshape(shape))
+
+
+def _without_scan_mean(hologram: Hologram) -> Hologram:
+    """A scanned transceiver's data less their mean over the scan positions (per
+    frequency and frame).
+
+    What is the same at every position (the antenna's coupling and ringing, the flat
+    surface's echo under a level scan) is often the strongest part of a scan, near
+    the antenna; it is flat, not compact, and it may sit where either convention
+    focuses it (a delay behind the antenna as well as in front), so it must not
+    decide. Its mean over the positions is all of it; a compact reflector's is a
+    small part of its own energy. Receiver arrays are left as they are (their
+    radiator's direct wave is :func:`_without_direct_wave`'s)."""
+    if not hologram.monostatic:
+        return hologram
+    d = hologram.data
+    return hologram.with_data(d - d.mean(axis=(-2, -1), keepdims=True))
 
 
 def default_ranges(hologram: Hologram) -> np.ndarray:
@@ -210,7 +230,8 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
         One or several frequencies (each imaged alone, intensities added).
     z : float or sequence of float, optional
         Ranges where the scene is, metres (the planes of an image to be made);
-        default :func:`default_ranges` in free space.
+        default :func:`default_ranges` in free space (a line scan: no default, no
+        verdict without them).
     **migrate_options
         Passed to :func:`holoradar.migrate` (``medium=``, ``frame=``).
 
@@ -242,6 +263,9 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
         if not (z_given.size and np.all(np.isfinite(z_given)) and np.all(z_given > 0)):
             raise ValueError(f"z must be finite ranges in front of the aperture (> 0 m), got "
                              f"{z!r}")
+    if z is None and hologram.is_line:
+        return IQSignCheck(None, float("nan"), (), "a line scan: its length says nothing of "
+                           "the depths its scene lies at; give z (the ranges imaged)")
     try:
         zs = default_ranges(hologram) if z is None else z_given
         zs = _spread(np.unique(zs), MAX_PLANES)
@@ -252,8 +276,9 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
         # beside the array, and it focuses in front as any scatterer does. A level
         # ground frame images the footprint only.
         opts["fov"] = "aperture" if opts.get("frame") == "ground" else "full"
-        views = [_without_direct_wave(_reduced(hologram.at_frequency(int(i))))
-                 for i in _spread(np.arange(hologram.nf), MAX_FREQUENCIES)]
+        views = [_without_scan_mean(_without_direct_wave(_reduced(
+            hologram.at_frequency(int(i))))) for i in _spread(np.arange(hologram.nf),
+                                                                MAX_FREQUENCIES)]
         sides = []
         for flip in (False, True):
             total: Any = 0.0
@@ -340,8 +365,9 @@ def iq_convention(hologram: Hologram, z: float | Sequence[float] | np.ndarray,
         # Both images assume the same illumination where the source is not given: the
         # comparison does not depend on it, and nothing was asked about it.
         warnings.simplefilter("ignore", IlluminationWarning)
-        as_is = _sharpness(migrate(hologram, z, **migrate_options).data)
-        flipped = _sharpness(migrate(conjugate(hologram), z, **migrate_options).data)
+        h = _without_scan_mean(hologram)
+        as_is = _sharpness(migrate(h, z, **migrate_options).data)
+        flipped = _sharpness(migrate(conjugate(h), z, **migrate_options).data)
     return "I+iQ" if as_is >= flipped else "I-iQ"
 
 

@@ -73,18 +73,21 @@ class Layout:
         Element pitch in ``length_unit`` when the file has no coordinates: a
         grid centred on 0.
     axes : str, optional
-        One letter per axis of the field array, in the file's order: ``y``,
-        ``x`` (required), ``f`` (frequency), ``t`` (frames: views, repeats,
-        positions), ``c`` (an I/Q pair axis of a real array, I first). Default:
-        ``yx`` with leading frames, the frequency third from last when its
-        length matches.
+        One letter per axis of the field array, in the file's order: ``x``
+        (required), ``y`` (a grid's rows; without it a line scan along x, a
+        B-scan: ``fx`` or ``xf``), ``f`` (frequency), ``t`` (frames: views,
+        repeats, positions), ``c`` (an I/Q pair axis of a real array, I first).
+        Default: ``yx`` with leading frames, the frequency third from last when
+        its length matches.
     length_unit : {"m", "cm", "mm"}
     frequency_unit : {"Hz", "kHz", "MHz", "GHz"}
     phase_unit : {"rad", "deg"}
     iq_sign : {"I+iQ", "I-iQ"}
         ``"I-iQ"``: the device records the conjugate (conjugated on reading).
-    monostatic : bool
-        A scanned transceiver (see :class:`~holoradar.Hologram`).
+    monostatic : bool, optional
+        A scanned transceiver (see :class:`~holoradar.Hologram`). Not given: a line
+        scan (``axes`` without ``y``) is a transceiver's (a GPR's B-scan), a grid a
+        receiver array's.
     tx_offset : list of float, optional
         A transmitter beside the scanned receiver, ``[dx, dy]`` or ``[dx, dy, dz]``
         in ``length_unit`` (``tx_offset=[120, 0, 0]`` with ``units=mm``): the
@@ -120,7 +123,7 @@ class Layout:
     frequency_unit: str = "Hz"
     phase_unit: str = "rad"
     iq_sign: str = "I+iQ"
-    monostatic: bool = False
+    monostatic: bool | None = None
     tx_offset: tuple[float, ...] | None = None
     wide: str | None = None
     response: str | None = None
@@ -155,10 +158,11 @@ class Layout:
                              "phase")
         if self.axes is not None:
             a = self.axes
-            if (not isinstance(a, str) or set(a) - set("yxftc") or a.count("y") != 1
+            if (not isinstance(a, str) or set(a) - set("yxftc") or a.count("y") > 1
                     or a.count("x") != 1 or a.count("f") > 1 or a.count("c") > 1):
                 raise ValueError("layout axes must name each axis of the field with one letter "
-                                 "of y, x (once each), f, c (at most once), t, e.g. 'fyx', got "
+                                 "of x (once), y, f, c (at most once each), t, e.g. 'fyx' "
+                                 "(a grid) or 'fx' (a line scan along x), got "
                                  f"{a!r}")
         if self.pitch is not None and not (isinstance(self.pitch, int | float)
                                            and np.isfinite(self.pitch) and self.pitch > 0):
@@ -170,7 +174,7 @@ class Layout:
                     or np.any(vals <= 0):
                 raise ValueError("layout frequency must be a variable name or positive "
                                  f"number(s), got {f!r}")
-        if not isinstance(self.monostatic, bool):
+        if self.monostatic is not None and not isinstance(self.monostatic, bool):
             raise ValueError(f"layout monostatic must be true or false, got {self.monostatic!r}")
         d = self.tx_offset
         if d is not None and (isinstance(d, str) or not _numeric(d)
@@ -522,9 +526,12 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
     order = [i for i, a in enumerate(axes) if a == "t"] + \
             [axes.index(a) for a in "fyx" if a in axes]
     field = np.transpose(field, order)
+    line = "y" not in axes
+    if line:   # a line scan along x: one row, at y = 0
+        field = field[..., None, :]
     ny, nx = field.shape[-2:]
     x = _coordinate(variables, lay, "x", nx, what)
-    y = _coordinate(variables, lay, "y", ny, what)
+    y = np.zeros(1) if line else _coordinate(variables, lay, "y", ny, what)
     if x is None or y is None:
         raise ValueError(f"{what}: no coordinates found. Needed: variables x and y (element "
                          "centres) or a pitch in the layout (pitch=0.025). Found: "
@@ -560,7 +567,8 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
 def _hologram(field: np.ndarray, x: np.ndarray, y: np.ndarray, f: Any, lay: Layout,
               what: str) -> Hologram:
     try:
-        return Hologram(field, x, y, f, monostatic=lay.monostatic,
+        mono = lay.monostatic if lay.monostatic is not None else y.size == 1
+        return Hologram(field, x, y, f, monostatic=mono,
                         tx_offset=layout_tx_offset(lay))
     except ValueError as exc:
         raise ValueError(f"{what}: {exc}") from None

@@ -272,7 +272,8 @@ def medium_from_mapping(m: Mapping[str, Any], frequency: float, where: str = "[g
             eps.append(_eps(la, w, frequency))
         return Medium.layered(tops, eps, polarization=m.get("polarization", polarization))
     _unknown(m, {"surface", "eps", "tan_delta", "sigma", "polarization"}, where)
-    surface = float(_number(m, "surface", where, positive=True, unit="m"))
+    # 0: the antennas on the ground (ground-coupled).
+    surface = float(_number(m, "surface", where, minimum=0.0, unit="m"))
     return Medium.half_space(surface, _eps(m, where, frequency),
                              polarization=m.get("polarization", polarization))
 

@@ -147,7 +147,7 @@ def simulate(scene: Scene, aperture: Aperture | np.ndarray, frequency: float | n
         warnings.warn("simulate: the elements record a polarisation but the source has none "
                       "(give it one, or use a Dipole): the scalar model is used",
                       UserWarning, stacklevel=2)
-    if not medium.is_free_space and np.any(pts[:, 2] >= medium.z_interfaces[0]):
+    if not medium.is_free_space and np.any(pts[:, 2] > medium.z_interfaces[0]):
         raise ValueError(f"aperture: its elements must lie above the ground surface (z < "
                          f"{medium.z_interfaces[0]} m); the deepest is at z = "
                          f"{pts[:, 2].max():.4g} m (check the pose's centre and tilt)")

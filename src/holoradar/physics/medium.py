@@ -233,9 +233,12 @@ class Medium:
         except (TypeError, ValueError):
             raise ValueError("z_interfaces must be ranges in metres (numbers > 0), got "
                              f"{self.z_interfaces!r}") from None
-        if any(not np.isfinite(z) or z <= 0 for z in zi):
-            raise ValueError("z_interfaces must be finite ranges > 0 m from the aperture "
-                             f"(the aperture lies in air), got {self.z_interfaces}")
+        # The first interface may be at 0: the antennas on the ground (ground-coupled),
+        # the aperture in the air just above the surface.
+        if any(not np.isfinite(z) or z < 0 for z in zi):
+            raise ValueError("z_interfaces must be finite ranges >= 0 m from the aperture "
+                             "(the aperture lies in air, on the surface at 0 at the "
+                             f"deepest), got {self.z_interfaces}")
         if any(b <= a for a, b in itertools.pairwise(zi)):
             raise ValueError(f"z_interfaces must be strictly increasing, got {zi}")
         eps = tuple(check_eps(e, f"eps[{i}]") for i, e in enumerate(np.atleast_1d(self.eps)))
@@ -419,6 +422,17 @@ class Medium:
         idx = np.searchsorted(np.asarray(self.z_interfaces), z, side="right")
         return int(idx) if np.ndim(idx) == 0 else idx
 
+    def on_surface(self, z: float) -> bool:
+        """Whether range ``z`` is the ground's surface itself (antennas on the ground:
+        the aperture just above it, in the air).
+
+        Examples
+        --------
+        >>> Medium.half_space(0.0, 6.0).on_surface(0.0)
+        True
+        """
+        return bool(self.z_interfaces) and float(z) == self.z_interfaces[0]
+
     def top_of(self, region: int) -> float:
         """Range of the upper boundary of a region (0 for the air)."""
         return 0.0 if region == 0 else self.z_interfaces[region - 1]
@@ -592,7 +606,7 @@ class Medium:
         z_from, z_to = float(z_from), float(z_to)
         down = z_to >= z_from
         z_air, z_far = (z_from, z_to) if down else (z_to, z_from)
-        if self.region_of(z_air) != 0:
+        if self.region_of(z_air) != 0 and not self.on_surface(z_air):
             raise ValueError("vertical_transfer needs one end in the air above the surface "
                              f"(range < {self.z_interfaces[0]} m), got z_from={z_from}, "
                              f"z_to={z_to}")

@@ -64,8 +64,9 @@ def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[floa
                  z_max: float = 0.0) -> tuple[int, int]:
     """FFT grid for an ``(ny, nx)`` field.
 
-    ``pad=False``: no padding (periodic). A float: that factor. ``pad=True``: at
-    least twice each size, and at least ``lambda*z_max/(dx*dx_edge)`` samples,
+    ``pad=False``: no padding (periodic). A float: that factor. An axis of one sample
+    (a line scan's row) is never padded. ``pad=True``: at least twice each size,
+    and at least ``lambda*z_max/(dx*dx_edge)`` samples,
     ``dx_edge = max(dx, lambda/2)``: the angular spectrum samples its transfer
     phase ``kz*z`` every ``dp = 2*pi/(M*dx)``, and at the highest travelling
     component ``p_edge = pi/dx_edge`` (the grid's band edge ``pi/dx``, or ``k``
@@ -81,6 +82,9 @@ def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[floa
     if pad is True:
         dims = []
         for n, d in zip(shape, pitch[::-1] if pitch else (None, None), strict=True):
+            if n == 1:   # a line scan's one row: its field does not vary along it
+                dims.append(1)
+                continue
             m = 2 * n
             if d is not None and wavelength is not None:
                 edge = max(d, wavelength / 2)
@@ -92,7 +96,8 @@ def padded_shape(shape: tuple[int, int], pad: bool | float, *, pitch: tuple[floa
         raise ValueError(f"pad must be True, False or a factor >= 1, got {pad!r}")
     if factor == 1:
         return tuple(shape)
-    return tuple(sfft.next_fast_len(int(np.ceil(factor * n)), real=False) for n in shape)
+    return tuple(1 if n == 1 else sfft.next_fast_len(int(np.ceil(factor * n)), real=False)
+                 for n in shape)
 
 
 def spectral_axes(shape: tuple[int, int], dx: float, dy: float) -> tuple[np.ndarray, np.ndarray]:

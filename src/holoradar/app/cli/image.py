@@ -29,8 +29,9 @@ __all__ = ["COMMANDS", "write_image"]
 
 
 def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
-                png: bool, title: str) -> list[str]:
-    """Write an image as .nc (with its history) or .npz, and a PNG of its brightest plane."""
+                png: bool, title: str, z_surface: float | None = None) -> list[str]:
+    """Write an image as .nc (with its history) or .npz, and a PNG of its brightest plane
+    (a line scan's: its x-z section, with the depth below ``z_surface``)."""
     from ...analysis.metrics import peak_position
     from ...io import save
     from ..atomic import write_atomic
@@ -50,7 +51,11 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
         from .. import plotting  # matplotlib: 0.3-0.6 s to import, only for the picture
 
         pk = peak_position(img)
-        fig = plotting.plot_image([img.plane(pk[2])], [title])
+        if img.y.size == 1 and img.has_z_axis and img.z.size > 1:
+            fig = plotting.plot_section(img, along="x", at=float(img.y[0]),
+                                        z_surface=z_surface, title=title)
+        else:
+            fig = plotting.plot_image([img.plane(pk[2])], [title])
         write_atomic(out.with_suffix(".png"), plotting.to_png(fig))
         files.append(str(out.with_suffix(".png")))
     return files
@@ -127,7 +132,9 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
         "parameters": {"z": z, "method": method, "frame": frame, "upsample": upsample,
                        "precision": "double" if double else "single",
                        "layout": layout, "medium": ground}, "warnings": texts}]
-    files = write_image(img, out, force, history, png, f"{hologram_file.name} ({method})")
+    surface = medium.z_interfaces[0] if medium is not None and medium.z_interfaces else None
+    files = write_image(img, out, force, history, png, f"{hologram_file.name} ({method})",
+                        z_surface=surface)
     report.done({"peak_m": pk, "out": str(out), "files": files, "planes": int(img.z.size),
                  "shape": list(img.data.shape), "seconds": seconds}, [
         f"imaged {hologram_file.name}: {img.z.size} plane(s), {img.x.size} x {img.y.size} "

@@ -31,7 +31,7 @@ __all__ = ["COMMANDS"]
 @click.option("--section", type=click.Choice(["none", "x", "y"]), default="none",
               show_default=True,
               help="Draw a vertical section (x-z or y-z through the brightest point) instead "
-                   "of planes.")
+                   "of planes (a line scan's image: its x-z section, always).")
 @click.option("--layout", default=None, metavar="KEY=VALUE,...",
               help="For a user's hologram file (see holoradar image --help).")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
@@ -59,6 +59,8 @@ def plot(file: Path, out: Path, zs: tuple[float, ...], db_range: float | None, s
         if z_surface is not None:
             _check_surface(obj, z_surface)
         pk = peak_position(obj)
+        if section == "none" and obj.y.size == 1 and obj.has_z_axis and obj.z.size > 1:
+            section = "x"   # a line scan's image is its x-z section
         if section != "none":
             if not obj.has_z_axis or obj.z.size < 2:
                 raise click.BadParameter("a section needs an image with several planes",
