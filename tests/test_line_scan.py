@@ -163,3 +163,28 @@ def test_a_b_scan_file_through_the_layout_and_the_command_line(bscan, tmp_path):
         "--z-surface", "0", "--z", "0.005:0.3:0.005", "-o", out)
     img = hr.load(out)
     assert img.data.shape[1] == 1 and out.with_suffix(".png").exists()
+
+
+def test_bars_across_a_b_scan_are_counted_with_their_spacing_and_cover():
+    # Five bars 15 cm apart, axes 10 cm deep (radius 8 mm: tops at 9.2 cm), under a
+    # ground-coupled scan: detect on the section finds five lines across the scan, and
+    # rebar_layers one layer. Bounds: spacing within 5 % (the spots' positions to a
+    # fraction of the 2 cm lateral cell over 15 cm), cover within a quarter of the
+    # range cell c / (2 B n) = 6.0 cm of the bars' tops.
+    ground = hr.Medium.half_space(0.0, EPS)
+    bars = [hr.LineTarget((x, -3.0, 0.10), (x, 3.0, 0.10), RADIUS)
+            for x in (-0.3, -0.15, 0.0, 0.15, 0.3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        h = hr.simulate(hr.Scene(ground, targets=bars),
+                        hr.Aperture.grid(100, PITCH, ny=1, monostatic=True),
+                        np.linspace(0.98e9, 2.0e9, 64), include_surface=False, snr_db=30,
+                        seed=1)
+    img = hr.migrate(h, np.arange(0.01, 0.25, 0.005), medium=ground)
+    df = hr.detect(img, medium=ground)
+    assert len(df) == 5 and set(df.kind) == {"line"} and np.allclose(df.azimuth_deg, 90.0)
+    layers = hr.rebar_layers(df)
+    assert len(layers) == 1 and int(layers.bars[0]) == 5
+    assert abs(layers.spacing[0] - 0.15) <= 0.05 * 0.15
+    quarter = C0 / (2 * 1.02e9 * np.sqrt(EPS)) / 4
+    assert abs(layers.cover[0] - (0.10 - RADIUS)) <= quarter

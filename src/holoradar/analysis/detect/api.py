@@ -158,6 +158,15 @@ def detect(image: Any, *, medium: Any = None, eps_interval: Any = None,
     if isinstance(max_objects, bool) or not isinstance(max_objects, int | np.integer) \
             or max_objects < 1:
         raise ValueError(f"max_objects must be a whole number >= 1, got {max_objects!r}")
+    if vol.y.size == 1:
+        # A line scan's x-z section: each spot one bar across the line.
+        if vol.z.size < 2:
+            raise ValueError("image: a line scan's image needs several ranges (an x-z "
+                             "section), got one plane")
+        from .section import detect_section
+
+        rows, meta = detect_section(vol, medium, fa, int(max_objects), interval)
+        return _frame([r for r in rows if r["kind"] in ks], meta, fa, interval)
     if hologram is not None:
         from .reflectivity import detect_by_inversion
 

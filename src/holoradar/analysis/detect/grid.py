@@ -73,7 +73,8 @@ def as_volume(image: Any) -> Volume:
     y = np.asarray(image.y, float)
     z = np.atleast_1d(np.asarray(image.z, float))
     _uniform(x, "x")
-    _uniform(y, "y")
+    if y.size != 1:   # one y: a line scan's x-z section
+        _uniform(y, "y")
     has_z = bool(getattr(image, "has_z_axis", data.ndim >= 3))
     vol = data[None] if not has_z else data
     if vol.ndim != 3 or vol.shape != (z.size, y.size, x.size):
