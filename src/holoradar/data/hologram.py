@@ -168,6 +168,65 @@ class Hologram(Band):
         object.__setattr__(self, "polarization", pol)
         object.__setattr__(self, "tx_offset", offset)
 
+    @classmethod
+    def from_traces(cls, traces: Any, dt: float, x: Any, *,
+                    band: tuple[float, float] | None = None, time_zero: float = 0.0,
+                    monostatic: bool = True, **options: Any) -> Hologram:
+        """A line scan from time-domain traces (pulse GPR's A-scans).
+
+        Parameters
+        ----------
+        traces : array_like, real or complex, shape (nt, nx)
+            One trace per position (columns), ``nt`` samples in time.
+        dt : float
+            Sample interval, seconds.
+        x : array_like, shape (nx,)
+            The positions along the line, metres, monotonic (a line walked backwards
+            is reversed with its traces).
+        band : (float, float), optional
+            ``(f_min, f_max)`` in Hz; default the antenna's, where the traces' mean
+            power spectrum is within 10 dB of its peak.
+        time_zero : float
+            When the pulse leaves the antenna, seconds from the first sample.
+        monostatic : bool
+            A transceiver (default; a GPR's antenna pair is taken as one).
+        **options
+            Other :class:`Hologram` options (``pose``, ``polarization``...).
+
+        Returns
+        -------
+        Hologram
+            A line scan (``is_line``) over the band's frequencies
+            (:func:`holoradar.data.traces.frequency_samples`: the FFT's bins, the
+            sign of ``exp(-i omega t)``, at most 256).
+
+        Examples
+        --------
+        >>> t = np.arange(512) * 0.1e-9
+        >>> traces = np.exp(-((t[:, None] - 3e-9) / 0.3e-9) ** 2) * np.ones((1, 8))
+        >>> h = Hologram.from_traces(traces, 0.1e-9, np.arange(8) * 0.02)
+        >>> h.is_line, h.monostatic, h.data.shape[1:]
+        (True, True, (1, 8))
+        """
+        from .traces import frequency_samples
+
+        arr = np.asarray(traces) if not isinstance(traces, list) else traces
+        S, f = frequency_samples(arr, dt, band=band, time_zero=time_zero)
+        if S.ndim != 2:
+            raise ValueError(f"traces must be 2-D, (time samples, positions), got shape "
+                             f"{np.shape(traces)}")
+        xs = np.asarray(x, dtype=float)
+        if xs.ndim != 1 or xs.size != S.shape[1]:
+            raise ValueError(f"x must hold one position per trace ({S.shape[1]}), got shape "
+                             f"{xs.shape}")
+        if xs.size < 2:
+            raise ValueError("x: a line scan needs at least 2 positions, got 1")
+        steps = np.diff(xs)
+        if not (np.all(steps > 0) or np.all(steps < 0)):
+            raise ValueError("x must be monotonic (the positions along the line in the order "
+                             "walked), got steps of both signs or repeats")
+        return cls(S, xs, frequency=f, monostatic=monostatic, **options)
+
     @property
     def is_vector(self) -> bool:
         """True when both the recorded component and the source's field are vectors: the

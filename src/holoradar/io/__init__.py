@@ -22,7 +22,8 @@ import numpy as np
 
 from ..data.hologram import Hologram, Image
 from ..data.plausibility import check_plausible
-from .layout import Layout, assemble
+from .gpr import GPR_SUFFIXES, read_gpr
+from .layout import LENGTH_UNITS, Layout, assemble
 from .netcdf import from_dataset, read_direct, read_history, to_dataset
 from .output import check_output, write_via_temp
 from .readers import read_variables
@@ -88,7 +89,10 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     path : str or path-like
         ``.nc`` written by :func:`save` (an equal object comes back), or a
         user's file: ``.npz``, ``.npy``, ``.mat`` (v5 and v7.3), ``.h5``/``.hdf5``,
-        ``.csv`` or a foreign ``.nc``; see :mod:`holoradar.io.readers`.
+        ``.csv`` or a foreign ``.nc``; see :mod:`holoradar.io.readers`; a GPR
+        vendor's line of traces (``.DZT``, ``.DT1``, ``.RD3``/``.RAD``, SEG-Y, through
+        impdar: :func:`holoradar.io.gpr.read_gpr`) as a line scan, its positions from
+        the header or the layout's ``pitch``.
     layout : Layout, dict or str, optional
         For a user's file: which variable is the field, the axes, the units
         (:class:`~holoradar.io.layout.Layout`; a string is its ``key=value,...``
@@ -155,6 +159,11 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     if obj is None and lay is not None and lay.wide is not None:
         obj = _wide(src, lay)
         device = "iq_sign" not in lay.given
+    if obj is None and src.suffix.lower() in GPR_SUFFIXES:
+        # A GPR vendor's line of traces (through impdar): real traces carry no I/Q sign.
+        pitch = None if lay is None or lay.pitch is None else \
+            lay.pitch * LENGTH_UNITS[lay.length_unit]
+        obj = read_gpr(src, pitch=pitch)
     if obj is None:
         variables = read_variables(src)
         sidecar = src.with_suffix(".json")

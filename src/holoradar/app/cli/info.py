@@ -96,10 +96,12 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
         if is_ours:  # a damaged holoradar file: its error is the answer
             raise
         reason = str(exc)
+    from ...io.gpr import GPR_SUFFIXES
     from ...io.layout import Layout
 
     wide = obj is not None and layout is not None and Layout.parse(layout).wide is not None
-    if (obj is None or not is_ours) and not wide:   # a wide table has no variables
+    gpr = file.suffix.lower() in GPR_SUFFIXES    # a GPR vendor's traces: no variables
+    if (obj is None or not is_ours) and not wide and not gpr:   # nor a wide table
         variables = read_variables(file)
         summary["variables"] = {k: {"shape": list(v.shape), "dtype": str(v.dtype)}
                                 for k, v in variables.items() if not k.startswith("__")}
