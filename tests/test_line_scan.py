@@ -188,3 +188,37 @@ def test_bars_across_a_b_scan_are_counted_with_their_spacing_and_cover():
     assert abs(layers.spacing[0] - 0.15) <= 0.05 * 0.15
     quarter = C0 / (2 * 1.02e9 * np.sqrt(EPS)) / 4
     assert abs(layers.cover[0] - (0.10 - RADIUS)) <= quarter
+
+
+def test_evenly_spaced_lines_are_one_grid_migrated_in_3d(rng):
+    # Rows of one grid given as lines: stacked, the volume is the grid's migration,
+    # bit for bit (the same hologram, made again from its rows).
+    x, y = np.arange(24) * 0.02, np.arange(6) * 0.03
+    data = rng.standard_normal((F.size, 6, 24)) + 1j * rng.standard_normal((F.size, 6, 24))
+    grid = hr.Hologram(data, x, y, F, monostatic=True)
+    lines = [hr.Hologram(data[:, j, :], x, frequency=F, monostatic=True) for j in range(6)]
+    zs = np.linspace(0.02, 0.2, 7)
+    ground = hr.Medium.half_space(0.0, EPS)
+    vol = hr.stack_lines(lines[::-1], y[::-1], zs, medium=ground)   # any order
+    assert vol.method == "lines:3d"
+    np.testing.assert_array_equal(vol.data, hr.migrate(grid, zs, medium=ground).data)
+
+
+def test_uneven_lines_with_their_own_starts_show_a_bar_across_them(bscan):
+    # Three lines at uneven y, each starting elsewhere, over the same bars (along y):
+    # each line's section shows every bar at its x on the common grid, within a pitch.
+    ground = hr.Medium.half_space(0.0, EPS)
+    zs = np.arange(0.02, 0.2, 0.005)
+    shifts = (0, 5, 11)   # traces cut from the start
+    lines = [hr.Hologram(bscan.data[:, 0, s:], bscan.x[s:], frequency=F, monostatic=True)
+             for s in shifts]
+    vol = hr.stack_lines(lines, [0.0, 0.07, 0.31], zs, medium=ground)
+    assert vol.method == "lines:2d" and vol.data.shape[1] == 3
+    a = np.abs(vol.data)
+    for j in range(3):
+        for xb, _ in BARS:
+            near = np.abs(vol.x - xb) < 0.08
+            ix = np.argmax(a[:, j, near].max(axis=0))
+            assert abs(vol.x[near][ix] - xb) <= PITCH
+    with pytest.raises(ValueError, match="one distinct position per line"):
+        hr.stack_lines(lines, [0.0, 0.0, 0.1], zs)

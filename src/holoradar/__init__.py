@@ -38,6 +38,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
     )
     from .imaging.inversion import invert
     from .imaging.iq import IQSignWarning, check_iq_sign, iq_convention
+    from .imaging.lines import stack_lines
     from .imaging.migrate import IlluminationWarning, migrate
     from .imaging.migration.linear import MigrationOperator, migration_operator
     from .imaging.migration.settings import MigrationSettings
@@ -114,6 +115,7 @@ _NAMES = {
     "simulate": ".model.simulate",
     "suppress_surface": ".imaging.glare",
     "synthesize": ".imaging.synthesis",
+    "stack_lines": ".imaging.lines",
 }
 
 def __getattr__(name: str) -> Any:
@@ -185,6 +187,7 @@ __all__ = [
     "report",
     "save",
     "simulate",
+    "stack_lines",
     "suppress_surface",
     "survey",
     "synthesize",
