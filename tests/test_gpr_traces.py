@@ -19,7 +19,7 @@ import holoradar as hr
 from holoradar.data.hologram import C0
 from holoradar.data.traces import frequency_samples
 
-DT, NT = 1e-9, 512          # 1 ns sampling (SEG-Y's interval in whole ns), 512 ns
+DT, NT = 1e-9, 256          # 1 ns sampling (SEG-Y's interval in whole ns), 256 ns
 EPS = 9.0                   # moist soil
 PIPES = ((-0.5, 1.0), (0.6, 1.5))   # (x, axis depth) of two pipes across the line
 RADIUS = 0.05
@@ -55,7 +55,7 @@ def test_traces_give_back_the_frequency_samples_they_hold(line):
     h, traces, S = line
     got, f = frequency_samples(traces, DT, band=(h.frequencies[0] - 1, h.frequencies[-1] + 1))
     np.testing.assert_allclose(f, h.frequencies)
-    # Two FFTs of 512 in float64: 1e-12 of the peak is rounding, a sign or a factor
+    # Two FFTs of 256 in float64: 1e-12 of the peak is rounding, a sign or a factor
     # of dt off is O(1).
     assert np.max(np.abs(got - S)) <= 1e-12 * np.max(np.abs(S))
     # A time zero t0 takes exp(-2 pi i f t0) off every sample.
@@ -69,7 +69,7 @@ def test_the_antennas_band_is_where_the_pulse_is(line):
     _, f = frequency_samples(traces, DT)
     # A Gaussian pulse spectrum exp(-((f - 250 MHz) / 100 MHz)^2) in power falls to
     # -10 dB at 250 +- 100 sqrt(ln(10) / 2) = 250 +- 107 MHz (the scene's own spectrum
-    # tilts it by a bin or two: 2 MHz bins here, allowed 10 MHz).
+    # tilts it by a bin or two: 4 MHz bins here, allowed 10 MHz).
     half = 100e6 * np.sqrt(np.log(10) / 2)
     assert abs(f[0] - (250e6 - half)) < 10e6 and abs(f[-1] - (250e6 + half)) < 10e6
 

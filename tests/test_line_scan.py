@@ -31,7 +31,7 @@ def bscan() -> hr.Hologram:
     bars: rows of induced dipoles, 6 m long: a line scan sees them as infinite)."""
     ground = hr.Medium.half_space(0.0, EPS)
     bars = [hr.LineTarget((x, -3.0, z), (x, 3.0, z), RADIUS) for x, z in BARS]
-    ap = hr.Aperture.grid(72, PITCH, ny=1, monostatic=True)
+    ap = hr.Aperture.grid(60, PITCH, ny=1, monostatic=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return hr.simulate(hr.Scene(ground, targets=bars), ap, F, include_surface=False,
@@ -105,12 +105,15 @@ def test_the_b_scan_image_agrees_with_delay_and_sum(bscan):
         R = np.hypot(x[None, :] - x[:, None], z)
         das[iz] = np.abs(np.einsum("fpa,fa->p", np.exp(-2j * np.sqrt(EPS) * k[:, None, None]
                                                        * R[None]), d))
+    # Each image's peak lies on its nearest plane, up to half a plane step (5 mm)
+    # from its own maximum: the two may differ by one step more than the quarter cell.
     quarter = C0 / (2 * np.ptp(F) * np.sqrt(EPS)) / 4
+    step = float(zs[1] - zs[0])
     for xb, _ in BARS:
         near = np.abs(x - xb) < 0.08
         p = [np.unravel_index(np.argmax(m[:, near]), m[:, near].shape) for m in (img, das)]
         assert abs(x[near][p[0][1]] - x[near][p[1][1]]) <= PITCH
-        assert abs(zs[p[0][0]] - zs[p[1][0]]) <= quarter
+        assert abs(zs[p[0][0]] - zs[p[1][0]]) <= quarter + step
 
 
 @pytest.mark.parametrize("delay", [-0.02, 0.0, 0.03])
@@ -177,8 +180,8 @@ def test_bars_across_a_b_scan_are_counted_with_their_spacing_and_cover():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         h = hr.simulate(hr.Scene(ground, targets=bars),
-                        hr.Aperture.grid(100, PITCH, ny=1, monostatic=True),
-                        np.linspace(0.98e9, 2.0e9, 64), include_surface=False, snr_db=30,
+                        hr.Aperture.grid(64, PITCH, ny=1, monostatic=True),
+                        np.linspace(0.98e9, 2.0e9, 48), include_surface=False, snr_db=30,
                         seed=1)
     img = hr.migrate(h, np.arange(0.01, 0.25, 0.005), medium=ground)
     df = hr.detect(img, medium=ground)
