@@ -225,3 +225,29 @@ def test_uneven_lines_with_their_own_starts_show_a_bar_across_them(bscan):
             assert abs(vol.x[near][ix] - xb) <= PITCH
     with pytest.raises(ValueError, match="one distinct position per line"):
         hr.stack_lines(lines, [0.0, 0.0, 0.1], zs)
+
+
+def test_line_scans_go_into_a_survey_store_and_its_map_has_a_row_per_line(tmp_path):
+    # Three lines at uneven y, each starting elsewhere (their poses), through the batch
+    # into a store: the map at the bars' depth holds one row per line, at the line's
+    # y, each bar within a pitch of its x.
+    ground = hr.Medium.half_space(0.0, EPS)
+    bars = [hr.LineTarget((x, -3.0, 0.10), (x, 3.0, 0.10), RADIUS) for x in (-0.2, 0.0, 0.2)]
+    f = np.linspace(0.98e9, 2.0e9, 32)
+    paths = []
+    for i, (x0, y0) in enumerate(((0.0, 0.0), (0.05, 0.1), (-0.03, 0.25))):
+        ap = hr.Aperture.grid(50, PITCH, ny=1, monostatic=True, pose=hr.Pose((x0, y0, 0.0)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            h = hr.simulate(hr.Scene(ground, targets=bars), ap, f, include_surface=False,
+                            snr_db=30, seed=i)
+        paths.append(hr.save(h, tmp_path / f"line{i}.nc"))
+    s = hr.survey.run_batch(paths, tmp_path / "s.zarr", z=np.arange(0.02, 0.2, 0.005),
+                            medium=ground, scheduler="synchronous")
+    assert s["done"] == 3 and not s["skipped"]
+    m = hr.survey.mosaic(tmp_path / "s.zarr", 0.09)
+    np.testing.assert_allclose(m.y, [0.0, 0.1, 0.25])
+    for row in m.data:
+        for xb in (-0.2, 0.0, 0.2):
+            near = np.abs(m.x - xb) < 0.05
+            assert abs(m.x[near][np.argmax(row[near])] - xb) <= PITCH

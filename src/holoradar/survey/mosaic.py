@@ -136,6 +136,10 @@ def mosaic(store: str | os.PathLike[str], depth: float, *, pitch: float | None =
         px, py = sx, sy
     fx, fy = idx["frame_x"][frames], idx["frame_y"][frames]
     gx = _grid(float(np.min(fx)) + xo[0], float(np.max(fx)) + xo[-1], fx[0] + xo[0], px)
+    if yo.size == 1:
+        # Line scans: one row per line, at the lines' own y (not evenly spaced).
+        gy = np.unique(np.round(fy + yo[0], 9))
+        return _line_mosaic(idx, frames, iz, gx, gy, xo, px)
     gy = _grid(float(np.min(fy)) + yo[0], float(np.max(fy)) + yo[-1], fy[0] + yo[0], py)
     num = np.zeros((gy.size, gx.size))
     den = np.zeros((gy.size, gx.size))
@@ -159,6 +163,37 @@ def mosaic(store: str | os.PathLike[str], depth: float, *, pitch: float | None =
             w = taper(gy[jy] - cy, hy, sy)[:, None] * taper(gx[jx] - cx, hx, sx)[None, :]
             num[np.ix_(jy, jx)] += w * val
             den[np.ix_(jy, jx)] += w
+    out = np.divide(num, den, out=np.zeros_like(num), where=den > 0)
+    geo = idx["attrs"]["geometry"]
+    f_hz = np.asarray(geo["frequency_hz"], float)
+    return Image(out, gx, gy, zs[iz:iz + 1].copy(), f_hz if geo["wideband"] else float(f_hz[0]),
+                 "mosaic", has_z_axis=False)
+
+
+def _line_mosaic(idx: dict, frames: np.ndarray, iz: int, gx: np.ndarray, gy: np.ndarray,
+                 xo: np.ndarray, px: float) -> Image:
+    """A survey of line scans mapped at one plane: each line's row at its y (lines at
+    one y blended with the frames' taper along x), on the x grid ``gx``."""
+    sx = float(xo[1] - xo[0]) if xo.size > 1 else px
+    num = np.zeros((gy.size, gx.size))
+    den = np.zeros((gy.size, gx.size))
+    hx = 0.5 * (xo[-1] - xo[0])
+    zs = idx["z"]
+    for b0 in range(0, frames.size, 64):
+        sel = frames[b0:b0 + 64]
+        amps = np.abs(read_images(idx, sel, plane=iz))
+        for k, f in enumerate(sel):
+            cx, cy = idx["frame_x"][f], idx["frame_y"][f]
+            jx, ix0, ax, _ = _bilinear_axis(gx, cx + xo[0], sx, xo.size)
+            if jx.size == 0:
+                continue
+            row = np.asarray(amps[k]).reshape(-1, xo.size)[0]
+            ix1 = np.minimum(ix0 + 1, xo.size - 1)
+            val = row[ix0] * (1 - ax) + row[ix1] * ax
+            jy = int(np.argmin(np.abs(gy - (cy + float(idx["y"][0])))))
+            w = taper(gx[jx] - cx, hx, sx)
+            num[jy, jx] += w * val
+            den[jy, jx] += w
     out = np.divide(num, den, out=np.zeros_like(num), where=den > 0)
     geo = idx["attrs"]["geometry"]
     f_hz = np.asarray(geo["frequency_hz"], float)
