@@ -10,8 +10,11 @@ metadata, a header row and one row per point::
 The header names the coordinate columns (``X``, ``Y``, and ``Z`` or an index column,
 any case; other names are ignored) and then each frequency twice: the real and the
 imaginary part (or, with ``wide=magphase``, the magnitude and the phase). The lines
-above the header (the export's metadata) are skipped. Columns are separated by
-commas, semicolons, tabs or spaces.
+above the header (the export's metadata) are skipped, and so are, below it, lines of
+words and the header repeated (an export may repeat its header block, with section
+titles, before the points); a row may carry its index as ``Point N``. A row of
+numbers of another length than the header's is refused (a cut or damaged file).
+Columns are separated by commas, semicolons, tabs or spaces.
 
 :func:`read_wide` turns such a table into the long form the layout's table
 gathering takes (one row per point and frequency: ``x``, ``y``, ``frequency`` and
@@ -114,8 +117,10 @@ def read_wide(path: Path, frequency_unit: str | None, values: str = "reim"
     hz = np.round(f * FREQUENCY_UNITS[unit], 3)     # 8.2 GHz is 8200000000 Hz, not ...999.999
     rows = []
     for n, line in enumerate(lines[head + 1:], start=head + 2):
-        cells = _cells(line)
-        if not cells:
+        cells = _point_label(_cells(line))
+        if not cells or cells == names or _number(cells[0]) is None:
+            # A blank line, the header again, or a line of words (an export repeats
+            # its header block, with section titles, before the points): not a point.
             continue
         if len(cells) != len(names):
             raise ValueError(f"{path.name} line {n}: {len(cells)} values for the header's "
@@ -141,6 +146,14 @@ def read_wide(path: Path, frequency_unit: str | None, values: str = "reim"
     variables = {"x": np.repeat(t[:, coords["x"]], nf), "y": np.repeat(t[:, coords["y"]], nf),
                  "frequency": np.tile(hz, npts), pair[0]: a.ravel(), pair[1]: b.ravel()}
     return variables, {"metadata": lines[:head], "frequency_unit": unit, "z": z}
+
+
+def _point_label(cells: list[str]) -> list[str]:
+    """A row labelled ``Point N`` (a scanner's own label of its index column): the
+    index alone, as the header's first column holds it."""
+    if len(cells) > 1 and cells[0].lower() == "point" and _number(cells[1]) is not None:
+        return cells[1:]
+    return cells
 
 
 def _header(lines: list[str], name: str) -> int:

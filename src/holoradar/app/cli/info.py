@@ -99,7 +99,7 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
     from ...io.gpr import GPR_SUFFIXES
     from ...io.layout import Layout
 
-    wide = obj is not None and layout is not None and Layout.parse(layout).wide is not None
+    wide = layout is not None and Layout.parse(layout).wide is not None
     gpr = file.suffix.lower() in GPR_SUFFIXES    # a GPR vendor's traces: no variables
     if (obj is None or not is_ours) and not wide and not gpr:   # nor a wide table
         variables = read_variables(file)
