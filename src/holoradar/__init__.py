@@ -18,7 +18,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what static checkers and IDEs see
-    from . import calibrate, survey, theory
+    from . import calibrate, io, survey, theory
     from ._validate import AliasingWarning
     from ._version import __version__
     from .analysis.detect import detect, rebar_layers, unbiased_peak
@@ -59,7 +59,7 @@ if TYPE_CHECKING:  # what static checkers and IDEs see
 # The public names, each imported from its module on first use (PEP 562): `import
 # holoradar` then costs little more than numpy even where bytecode is not cached (every
 # module compiled afresh), and `hr.migrate` etc. behave as plain attributes.
-_SUBMODULES = ("calibrate", "survey", "theory")
+_SUBMODULES = ("calibrate", "io", "survey", "theory")
 _NAMES = {
     "__version__": "._version",
     "AliasingWarning": "._validate",
@@ -175,6 +175,7 @@ __all__ = [
     "detect",
     "estimate_permittivity",
     "invert",
+    "io",
     "iq_convention",
     "load",
     "migrate",

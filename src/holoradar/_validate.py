@@ -49,8 +49,11 @@ def as_finite_complex(data: object, name: str, *, min_ndim: int = 0) -> np.ndarr
         raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
     if arr.ndim < min_ndim:
         raise ValueError(f"{name} must have at least {min_ndim} dimensions, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite: it contains NaN or inf values")
+    finite = np.isfinite(arr)
+    if not np.all(finite):
+        bad = np.argwhere(~finite)
+        raise ValueError(f"{name} must be finite: {bad.shape[0]} of {arr.size} values are NaN "
+                         f"or inf, the first at index {tuple(int(i) for i in bad[0])}")
     if not np.iscomplexobj(arr):
         arr = arr.astype(np.complex128)
     return arr

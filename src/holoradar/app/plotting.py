@@ -65,10 +65,10 @@ def plot_image(images: Sequence[Image], titles: Sequence[str], *,
         a = np.abs(img.data.reshape((-1, *img.data.shape[-2:]))[0])
         if db_range is None:
             a = a / a.max() if a.max() > 0 else a
-            vmin, vmax, label = 0.0, 1.0, "|E| / max"
+            vmin, vmax, label = 0.0, 1.0, f"{_quantity(img)} / max"
         else:
             a = 20 * np.log10(np.maximum(a / ref, 10 ** (-db_range / 20)))
-            vmin, vmax, label = -db_range, 0.0, "|E| (dB re first panel's max)"
+            vmin, vmax, label = -db_range, 0.0, f"{_quantity(img)} (dB re first panel's max)"
         m = ax.pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, a, cmap="inferno",
                           vmin=vmin, vmax=vmax, shading="flat")
         if outline is not None:
@@ -217,11 +217,18 @@ def plot_oblique_plan(plan: Any, aperture: Any, source: Any, medium: Any,
     return fig
 
 
-def _scaled(a: np.ndarray, ref: float, db_range: float | None) -> tuple[np.ndarray, float,
-                                                                       float, str]:
+def _quantity(img: Image) -> str:
+    """What an image's magnitude is, for its colour bar: an inverted reflectivity (the
+    Born amplitude per voxel), a mosaic's blended magnitude, or a migrated field."""
+    method = str(getattr(img, "method", "") or "")
+    return "|reflectivity|" if method.startswith("invert") else "|E|"
+
+
+def _scaled(a: np.ndarray, ref: float, db_range: float | None, quantity: str = "|E|"
+            ) -> tuple[np.ndarray, float, float, str]:
     if db_range is None:
-        return scaled(a, ref, "linear", 0.0), 0.0, 1.0, "|E| / max"
-    return scaled(a, ref, "db", db_range), -db_range, 0.0, "|E| (dB re max)"
+        return scaled(a, ref, "linear", 0.0), 0.0, 1.0, f"{quantity} / max"
+    return scaled(a, ref, "db", db_range), -db_range, 0.0, f"{quantity} (dB re max)"
 
 
 def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = None,
@@ -247,7 +254,7 @@ def plot_planes(img: Image, zs: Sequence[float], *, db_range: float | None = Non
     axes = np.atleast_1d(fig.subplots(1, len(panels)))
     for ax, p, i in zip(axes, panels, idx, strict=True):
         ref = gmax if shared else (float(p.max()) or 1.0)
-        a, vmin, vmax, label = _scaled(p, ref, db_range)
+        a, vmin, vmax, label = _scaled(p, ref, db_range, _quantity(img))
         m = ax.pcolormesh(_edges(img.x) * CM, _edges(img.y) * CM, a, cmap="inferno",
                           vmin=vmin, vmax=vmax, shading="flat")
         ax.set_aspect("equal")
@@ -277,7 +284,7 @@ def plot_section(img: Image, *, along: str = "x", at: float = 0.0,
     else:
         j = int(np.argmin(np.abs(img.x - at)))
         sec, h, where = vol[:, :, j], img.y, f"x = {img.x[j] * CM:.1f} cm"
-    a, vmin, vmax, label = _scaled(sec, float(sec.max()) or 1.0, db_range)
+    a, vmin, vmax, label = _scaled(sec, float(sec.max()) or 1.0, db_range, _quantity(img))
     fig = Figure(figsize=(8.0, 5.0), layout="constrained")
     ax = fig.subplots()
     m = ax.pcolormesh(_edges(h) * CM, _edges(img.z) * CM, a, cmap="inferno", vmin=vmin,

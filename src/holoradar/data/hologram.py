@@ -168,6 +168,26 @@ class Hologram(Band):
         object.__setattr__(self, "polarization", pol)
         object.__setattr__(self, "tx_offset", offset)
 
+    def __repr__(self) -> str:
+        """A summary (the samples are many): shape, band, grid, kind, source.
+
+        Examples
+        --------
+        >>> x = np.arange(16) * 0.01
+        >>> print(str(Hologram(np.zeros((16, 16)), x, x, 9.9e9)).replace("; ", ";\\n"))
+        <holoradar.Hologram (16, 16) complex128: 9.9 GHz;
+        x 0 to 15 cm, y 0 to 15 cm (1 x 1 cm);
+        receiver array, no source>
+        """
+        kind = ("line scan along x, " if self.is_line else "") + (
+            "transceiver pair (tx_offset)" if self.tx_offset is not None else
+            "scanned transceiver" if self.monostatic else "receiver array")
+        src = "" if self.monostatic else (
+            f", source {type(self.source).__name__}" if self.source is not None
+            else ", no source")
+        return (f"<holoradar.Hologram {self.data.shape} {self.data.dtype}: "
+                f"{_band_text(self.frequencies)}; {_grid_text(self.x, self.y)}; {kind}{src}>")
+
     @classmethod
     def from_traces(cls, traces: Any, dt: float, x: Any, *,
                     band: tuple[float, float] | None = None, time_zero: float = 0.0,
@@ -405,6 +425,29 @@ class Image:
     has_z_axis: bool = True
     history: tuple = ()
 
+    def __repr__(self) -> str:
+        """A summary: shape, ranges, grid, band and how it was made.
+
+        Examples
+        --------
+        >>> x = np.arange(4) * 0.01
+        >>> img = Image(np.zeros((2, 4, 4)), x, x, np.array([0.2, 0.3]), 9.9e9, "angular")
+        >>> print(str(img).replace("; ", ";\\n"))
+        <holoradar.Image (2, 4, 4) float64: z 20 to 30 cm (2 planes);
+        x 0 to 3 cm, y 0 to 3 cm (1 x 1 cm);
+        9.9 GHz;
+        angular>
+        """
+        z = np.atleast_1d(np.asarray(self.z, float))
+        zt = f"z {z[0] * 100:.4g} cm" if z.size == 1 else \
+            f"z {z[0] * 100:.4g} to {z[-1] * 100:.4g} cm ({z.size} planes)"
+        f = np.atleast_1d(np.asarray(self.frequency, float)) if self.frequency is not None \
+            else np.array([])
+        band = _band_text(f) if f.size and np.all(np.isfinite(f)) else "no frequency"
+        return (f"<holoradar.Image {np.shape(self.data)} {np.asarray(self.data).dtype}: {zt}; "
+                f"{_grid_text(np.atleast_1d(self.x), np.atleast_1d(self.y))}; {band}; "
+                f"{self.method or 'image'}>")
+
     @property
     def intensity(self) -> np.ndarray:
         """``|data|^2``."""
@@ -478,3 +521,21 @@ def _regular(values: Any, data: np.ndarray, name: str, axis: int) -> tuple[Any, 
     if v.ndim != 1 or v.size != data.shape[axis] or not np.all(np.isfinite(v)):
         return values, data
     return regular_axis(v, data, name, axis)
+
+
+def _band_text(f: np.ndarray) -> str:
+    """``9.9 GHz``, or ``8 to 12 GHz (11 frequencies)``."""
+    if f.size == 1:
+        return f"{f[0] / 1e9:.4g} GHz"
+    return f"{f[0] / 1e9:.4g} to {f[-1] / 1e9:.4g} GHz ({f.size} frequencies)"
+
+
+def _grid_text(x: np.ndarray, y: np.ndarray) -> str:
+    """``x 0 to 15 cm, y 0 to 15 cm (1 x 1 cm)``: the axes' spans and steps."""
+    def span(a: np.ndarray, name: str) -> str:
+        return f"{name} {a[0] * 100:.4g}" + (f" to {a[-1] * 100:.4g} cm" if a.size > 1 else " cm")
+
+    def step(a: np.ndarray) -> str:
+        return f"{(a[1] - a[0]) * 100:.3g}" if a.size > 1 else "-"
+
+    return f"{span(x, 'x')}, {span(y, 'y')} ({step(x)} x {step(y)} cm)"

@@ -144,6 +144,20 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
     ((0.025, 0.025), 9900000000.0)
     """
     src = Path(path)
+    try:
+        return _load(src, layout, check, iq_check)
+    except ValueError as exc:
+        if src.name in str(exc) or src.with_suffix(".json").name in str(exc):
+            raise   # it names the file (or its sidecar) already
+        # Every refusal names the file it is about.
+        try:
+            named = type(exc)(f"{src.name}: {exc}")
+        except TypeError:   # a subclass with other arguments
+            named = ValueError(f"{src.name}: {exc}")
+        raise named from exc
+
+
+def _load(src: Path, layout: Any, check: bool, iq_check: bool) -> Hologram | Image:
     lay = as_layout(layout)
     obj = None
     device = False
@@ -193,7 +207,7 @@ def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | s
             # engineering convention (I - jQ) would image as a blur without a word.
             from ..imaging.iq import warn_if_conjugated
 
-            warn_if_conjugated(obj, what=src.name, fix=_IQ_FIX, stacklevel=2)
+            warn_if_conjugated(obj, what=src.name, fix=_IQ_FIX, stacklevel=3)
     return obj
 
 

@@ -107,7 +107,8 @@ def noise_std(hologram: Hologram, z_min: float, noise: Any) -> tuple[float, str]
             f"estimated from the evanescent band (SNR {snr:.1f} dB)"
     warnings.warn(f"the receiver noise cannot be estimated from this hologram (its pitch is "
                   f"not below half a wavelength): {DEFAULT_SNR_DB:.0f} dB below the data's "
-                  "mean power assumed; give noise= (its standard deviation per sample) for "
+                  "mean power assumed; give the noise (noise=, or --noise on the command "
+                  "line: its standard deviation per sample) for "
                   "the inversion's stop and threshold", NoiseWarning,
                   stacklevel=outside_stacklevel())
     return math.sqrt(power / 10 ** (DEFAULT_SNR_DB / 10)), \
