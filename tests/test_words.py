@@ -63,3 +63,28 @@ def test_a_reflectivity_is_labelled_as_such():
     field = hr.Image(np.ones((2, 4, 4)), x, x, np.array([0.2, 0.3]), 9.9e9, "angular")
     labels = [plotting.plot_planes(img, [0.2]).axes[-1].get_ylabel() for img in (refl, field)]
     assert labels[0].startswith("|reflectivity|") and labels[1].startswith("|E|")
+
+
+def test_a_hologram_loaded_and_saved_again_keeps_its_steps(tmp_path):
+    x = np.arange(8) * 0.01
+    first = hr.save(hr.Hologram(np.ones((8, 8)), x, x, 9.9e9), tmp_path / "a.nc",
+                    history=[{"step": "simulate", "parameters": {"scene": "test"}}])
+    again = hr.save(hr.load(first), tmp_path / "b.nc")
+    assert [s["step"] for s in hr.io.read_history(again)] == ["simulate", "save", "save"]
+
+
+def test_info_names_the_solvers_step_and_batch_says_no_zarr_spec_note(tmp_path):
+    from cli_helpers import run
+
+    sc = hr.Scene(targets=[hr.PointTarget((0.0, 0.0, 0.3))], source=hr.PlaneWave())
+    h = hr.simulate(sc, hr.Aperture.grid(16, 0.0125), 9.9e9, snr_db=30, seed=1)
+    p = hr.save(h, tmp_path / "p.nc")
+    run("invert", p, "--z", "0.25:0.35:0.05", "-o", tmp_path / "r.nc")
+    out = run("info", tmp_path / "r.nc").output
+    assert "history: None" not in out and "history: invert" in out
+    x = (np.arange(8) - 3.5) * 0.01
+    frames = [hr.save(hr.Hologram(np.ones((8, 8)), x, x, 9.9e9,
+                                  pose=hr.Pose((0.05 * i, 0.0, 0.0))), tmp_path / f"f{i}.nc")
+              for i in range(2)]
+    res = run("batch", *frames, "-o", tmp_path / "s.zarr", "--z", "0.1:0.2:0.05")
+    assert "ZarrUserWarning" not in res.output

@@ -11,9 +11,11 @@ is described in :mod:`holoradar.io.netcdf`), and reads a user's own files
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import warnings
+import weakref
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -34,6 +36,11 @@ __all__ = ["Layout", "NonFiniteWarning", "load", "read_history", "read_sidecar",
 NETCDF_SUFFIXES = (".nc", ".nc4")
 
 
+#: The steps read with each hologram :func:`load` returned from holoradar's own file
+#: (held weakly: gone with the hologram), which :func:`save` writes again before its own.
+LOADED_HISTORY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool = False,
          history: list[dict[str, Any]] | None = None) -> Path:
     """Write a Hologram or Image to a NetCDF-4 file.
@@ -47,7 +54,8 @@ def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool
         Replace an existing file (default False: an existing file is an error).
     history : list of dict, optional
         Processing steps that led to ``obj`` (each with ``step``, ``parameters``,
-        ...); a ``save`` step is appended.
+        ...); a ``save`` step is appended. A hologram read by :func:`load` from
+        holoradar's file and saved as it is keeps that file's steps before these.
 
     Returns
     -------
@@ -72,7 +80,8 @@ def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool
         raise ValueError(f"obj must be a holoradar.Hologram or holoradar.Image, got "
                          f"{type(obj).__name__}")
     target = check_output(path, suffixes=NETCDF_SUFFIXES, overwrite=overwrite)
-    ds = to_dataset(obj, history)
+    earlier = LOADED_HISTORY.get(obj, []) if isinstance(obj, Hologram) else []
+    ds = to_dataset(obj, [*earlier, *(history or [])] if earlier else history)
 
     def write(tmp: Path) -> None:
         ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=False)
@@ -170,6 +179,11 @@ def _load(src: Path, layout: Any, check: bool, iq_check: bool) -> Hologram | Ima
             obj = None
         if obj is None and is_holoradar_netcdf(src):
             obj = _load_netcdf(src)  # ours but odd: the xarray reader names the problem
+    if obj is not None and isinstance(obj, Hologram):
+        # Its steps so far, for the next save of this same object (a hologram holds
+        # no history of its own).
+        with contextlib.suppress(Exception):
+            LOADED_HISTORY[obj] = [s for s in read_history(src) if isinstance(s, dict)]
     if obj is None and lay is not None and lay.wide is not None:
         obj = _wide(src, lay)
         device = "iq_sign" not in lay.given

@@ -143,7 +143,8 @@ def info(file: Path, layout: str | None, report: Reporter) -> None:
         summary["history"] = hist
         cut = False
         for step in hist:
-            lines.append(f"  history: {step.get('step')} {step.get('time', '')} "
+            lines.append(f"  history: {step.get('step', step.get('name'))} "
+                         f"{step.get('time', '')} "
                          f"(holoradar {step.get('holoradar', '?')})")
             text, short = _parameters(step)
             cut = cut or short
