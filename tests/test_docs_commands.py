@@ -39,7 +39,7 @@ def test_the_pages_show_commands():
 
 # The pages whose commands take several seconds end to end (each command is also tested
 # on its own in test_cli_commands.py): run with make test-slow.
-_LONG_PAGES = {"cli.md", "viewer.md", "surveys.md"}
+_LONG_PAGES = {"cli.md", "viewer.md", "surveys.md", "inversion.md"}
 
 
 @pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.slow)

@@ -112,9 +112,10 @@ def _notes(table: Any) -> str:
                                                       strict=True))
                  if math.isfinite(_number(d)) and not math.isfinite(_number(lo))]
         if plane:
-            notes.append(f"Object(s) {', '.join(map(str, plane))}: found on one plane from "
-                         "the image alone, so the depth is the plane's and has no interval "
-                         "(give the hologram for a fitted range with its 95 % interval).")
+            notes.append(f"Object(s) {', '.join(map(str, plane))}: no depth interval, the "
+                         "range's uncertainty not being known (an object found from the "
+                         "image alone on one plane takes that plane's range; give the "
+                         "hologram for a fitted range with its 95 % interval).")
     if "depth" in table.columns and not any(math.isfinite(_number(d)) for d in table["depth"]):
         notes.append("No depths: no ground with a surface was given or found; ranges are "
                      "from the array.")
