@@ -201,3 +201,23 @@ def test_rebar_mat_eps_from_its_bars():
     assert lo <= 6 <= hi and (hi - lo) / res.eps <= 0.20, (res.eps, res.eps_interval)
     assert res.focus_fraction > 0.99
     print(f"rebar mat: eps' {res.eps:.3f} in {lo:.3f}..{hi:.3f}, {seconds:.1f} s")
+
+
+def test_the_parabolas_find_the_vertex_of_an_exact_parabola():
+    # A focus that is exactly a parabola in log eps' with its top at eps' = 5.3: the
+    # successive parabolas through the best three trials land on its vertex (one step
+    # from three exact samples), to 1e-3 relative. A vertex taken with the wrong sign
+    # walks away from the top (each move is bounded, so it never reaches it).
+    from holoradar.imaging.autofocus.line_search import _parabolas
+
+    class Search:
+        lo, hi = 1.5, 16.0
+
+        def __init__(self) -> None:
+            self.best: dict[float, tuple[float]] = {}
+
+        def evaluate(self, e: float) -> None:
+            self.best[e] = (-(np.log(e) - np.log(5.3)) ** 2,)
+
+    found = _parabolas(Search(), 5.0, 0.02)
+    assert abs(found / 5.3 - 1) < 1e-3

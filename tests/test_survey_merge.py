@@ -193,3 +193,15 @@ def test_spacing_is_between_bars_side_by_side_not_end_to_end():
     t = merge(pd.DataFrame(rows)).sort_values(["x", "y"])
     assert t.spacing.tolist()[:2] == pytest.approx([0.15, 0.15])
     assert np.isnan(t.spacing.tolist()[2])
+
+
+def test_two_frames_seeing_points_at_one_place_and_two_depths_keep_two_rows():
+    # One frame sees a point 10 cm deep, another a point at the same (x, y) 30 cm deep:
+    # their 95 % depth intervals (a centimetre each) are 18 cm apart, so they are two
+    # objects, one above the other, not one seen twice.
+    def deep(row, depth):
+        return {**row, "depth": depth, "depth_low": depth - 0.01, "depth_high": depth + 0.01}
+
+    t = merge(pd.DataFrame([deep(_point("f0", 0.0, 0.0), 0.10),
+                            deep(_point("f1", 0.001, 0.0), 0.30)]))
+    assert sorted(t.depth) == [0.10, 0.30] and list(t.frames) == ["f0", "f1"]
