@@ -99,3 +99,37 @@ def test_frequencies_written_in_hz_are_taken_in_hz():
     p = Path(tempfile.mkdtemp()) / "f.txt"
     p.write_text("2e8\n5e8\n9e8\n")
     assert read_frequencies(p).tolist() == [2e8, 5e8, 9e8]
+
+
+@pytest.mark.parametrize("kind", ["mat", "npz"])
+def test_a_response_in_the_devices_own_convention_from_any_file(tmp_path, kind):
+    # A device recording I - jQ (the conjugate of holoradar's I + iQ) measures its own
+    # response in that convention too. Both given as recorded, with iq_sign=I-iQ, the
+    # division gives the scene's field exactly (the response is conjugated with the
+    # data). Divided the other way round, the response's phase would count twice.
+    import scipy.io
+
+    h, _, _ = _device(tmp_path)
+    resp = (1 + 0.2 * np.arange(3)) * np.exp(1j * np.array([0.3, 1.9, 3.4]))
+    np.savez(tmp_path / "scan.npz", data=np.conj(h.data * resp[:, None, None]), x=X, y=X)
+    recorded = np.conj(resp)            # the response as the device records it
+    if kind == "mat":
+        path = tmp_path / "ProbeResponse.mat"
+        scipy.io.savemat(path, {"freq": F, "S21": recorded})
+    else:
+        path = tmp_path / "probe.npz"
+        np.savez(path, frequency=F, re=recorded.real, im=recorded.imag)
+    got = hr.load(tmp_path / "scan.npz", layout="axes=fyx, frequency=[5.7, 6.95, 8.2], "
+                  f"frequency_unit=GHz, monostatic=true, response={path.name}, iq_sign=I-iQ")
+    assert np.max(np.abs(got.data - h.data)) <= 1e-12 * np.max(np.abs(h.data))
+
+
+def test_a_response_file_that_is_not_one_is_named(tmp_path):
+    import scipy.io
+
+    _device(tmp_path)
+    path = tmp_path / "two.mat"
+    scipy.io.savemat(path, {"freq": F, "a": F * 1j, "b": F * 2j})
+    with pytest.raises(ValueError, match=r"two\.mat: a response needs .*\(2 complex ones"):
+        hr.load(tmp_path / "scan.npz", layout="axes=fyx, frequency=[5.7, 6.95, 8.2], "
+                f"frequency_unit=GHz, monostatic=true, response={path.name}")

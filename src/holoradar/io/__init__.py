@@ -213,7 +213,9 @@ def _load(src: Path, layout: Any, check: bool, iq_check: bool) -> Hologram | Ima
     if response is not None and isinstance(obj, Hologram):
         from .response import apply_response
 
-        obj = apply_response(obj, response)
+        # The response is in the device's convention, as the data were recorded.
+        conj = used is not None and getattr(used, "iq_sign", "I+iQ") == "I-iQ"
+        obj = apply_response(obj, response, conjugate=conj)
     if check and isinstance(obj, Hologram):
         check_plausible(obj, what=src.name)
         if device and iq_check:

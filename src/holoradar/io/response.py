@@ -1,6 +1,10 @@
-"""A device's per-frequency response and frequency list, read from small text tables.
+"""A device's per-frequency response and frequency list, read from files.
 
-A response table (CSV, a header row) gives the device's complex response at each of
+A response is given in the device's own convention, as its data are recorded (where
+the layout says ``iq_sign=I-iQ`` both are conjugated: dividing the recorded data by
+the recorded response is what is done). A response table (CSV, a header row), or
+any file :func:`holoradar.load` reads (MATLAB, NumPy, HDF5: the same names as
+variables, or one complex variable), gives the device's complex response at each of
 its frequencies: a ``frequency`` column and either ``re``/``im`` (also ``real``/
 ``imag``, ``I``/``Q``), ``amplitude``/``phase`` (also ``magnitude``; ``phase`` in
 radians, ``phase_deg`` in degrees) or ``phase`` alone. Each frequency of the data is
@@ -66,26 +70,40 @@ def read_frequencies(path: str | Path) -> np.ndarray:
 
 
 def read_response(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """The table's frequencies (Hz) and the complex response at each.
+    """The file's frequencies (Hz) and the complex response at each.
+
+    A CSV or text table (module notes), or any file :func:`holoradar.load` reads
+    (MATLAB, NumPy, HDF5, NetCDF): its variables are looked up by the same names
+    (``frequency``...; ``re``/``im``, ``amplitude``/``phase``), a complex variable as
+    long as the frequencies being the response itself.
 
     Raises
     ------
     ValueError
-        No frequency column, no response columns (naming the columns found).
+        Unreadable, no frequency variable or column, no response (naming what the file
+        holds).
     """
-    from .readers import read_csv
-
     p = Path(path)
-    try:
-        cols = read_csv(p)
-    except OSError as exc:
-        raise ValueError(f"{p.name}: cannot read it ({exc})") from None
+    if p.suffix.lower() in (".csv", ".txt", ".tsv", ".dat", ""):
+        from .readers import read_csv
+
+        try:
+            cols = read_csv(p)
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{p.name}: cannot read it as a table ({exc})") from None
+    else:
+        from .readers import read_variables
+
+        cols = {k: np.asarray(v) for k, v in read_variables(p).items()
+                if not k.startswith("__")}
+        cols = {k: v.ravel() for k, v in cols.items() if v.size > 1 and v.squeeze().ndim == 1}
     low = {k.strip().lower(): v for k, v in cols.items()}
-    fcol = next((low[k] for k in ("frequency", "frequency_hz", "freq", "f", "frequency_ghz")
-                 if k in low), None)
-    if fcol is None:
-        raise ValueError(f"{p.name}: a response table needs a frequency column; found "
-                         f"{sorted(cols)}")
+    fname = next((k for k in ("frequency", "frequency_hz", "freq", "f", "frequency_ghz",
+                              "frequencies", "freqs") if k in low), None)
+    if fname is None:
+        raise ValueError(f"{p.name}: a response table needs a frequency column (or a "
+                         f"variable named frequency, freq or f); found {sorted(cols)}")
+    fcol = low[fname]
     f = _hz(np.asarray(fcol, float), p.name)
 
     def pick(*names: str) -> Any:
@@ -94,21 +112,35 @@ def read_response(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     re, im = pick("re", "real", "i"), pick("im", "imag", "q")
     amp, ph, ph_deg = pick("amplitude", "magnitude", "amp", "mag"), pick("phase"), \
         pick("phase_deg")
+    complex_ = [v for k, v in low.items()
+                if k != fname and np.iscomplexobj(v) and np.size(v) == f.size]
     if re is not None and im is not None:
         r = np.asarray(re, float) + 1j * np.asarray(im, float)
     elif ph is not None or ph_deg is not None:
         phase = np.asarray(ph, float) if ph is not None else np.radians(np.asarray(ph_deg,
                                                                                   float))
         r = (np.asarray(amp, float) if amp is not None else 1.0) * np.exp(1j * phase)
+    elif len(complex_) == 1:
+        r = complex_[0]
     else:
-        raise ValueError(f"{p.name}: a response table needs re and im, or amplitude and "
-                         f"phase (or phase_deg), or phase alone; found {sorted(cols)}")
+        more = f" ({len(complex_)} complex ones: which?)" if complex_ else ""
+        raise ValueError(f"{p.name}: a response needs re and im, or amplitude and phase (or "
+                         f"phase_deg), or phase alone, or one complex variable as long as "
+                         f"its frequencies{more}; found {sorted(cols)}")
+    r = np.asarray(r).ravel()
+    if r.size != f.size:
+        raise ValueError(f"{p.name}: the response holds {r.size} values for {f.size} "
+                         "frequencies")
     order = np.argsort(f)
     return f[order], np.asarray(r, complex)[order]
 
 
-def apply_response(hologram: Any, path: str | Path) -> Any:
-    """``hologram`` divided by the response a table gives (module notes).
+def apply_response(hologram: Any, path: str | Path, *, conjugate: bool = False) -> Any:
+    """``hologram`` divided by the response a file gives (module notes).
+
+    ``conjugate``: the response is written in the device's own convention, ``I - jQ``,
+    as its data are; they were conjugated on reading (``iq_sign=I-iQ``), so the
+    response is too before it is divided out (the same as dividing first).
 
     Raises
     ------
@@ -119,6 +151,8 @@ def apply_response(hologram: Any, path: str | Path) -> Any:
     from ..data.wideband import apply_calibration
 
     f, r = read_response(path)
+    if conjugate:
+        r = np.conj(r)
     try:
         return apply_calibration(hologram, f, r, kind="complex")
     except ValueError as exc:
