@@ -275,7 +275,10 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
         # The whole padded grid: the glare's focus (the horn's mirror image) often lies
         # beside the array, and it focuses in front as any scatterer does. A level
         # ground frame images the footprint only.
-        opts["fov"] = "aperture" if opts.get("frame") == "ground" else "full"
+        # A transmitter beside the receiver (tx_offset) has its own two-leg kernel, on the
+        # footprint only.
+        opts["fov"] = "aperture" if opts.get("frame") == "ground" or \
+            hologram.tx_offset is not None else "full"
         views = [_without_scan_mean(_without_direct_wave(_reduced(
             hologram.at_frequency(int(i))))) for i in _spread(np.arange(hologram.nf),
                                                                 MAX_FREQUENCIES)]
