@@ -80,6 +80,10 @@ def test_json_holds_the_records_and_the_metadata(files):
 
 
 UTM33 = "EPSG:32633"
+# Web Mercator: a projected CRS in metres whose area of use holds a scene's local
+# metres near (0, 0) (UTM's does not: x = 0 there is 500 km west of its meridian, and
+# such positions are refused).
+LOCAL = "EPSG:3857"
 
 
 def test_geojson_is_longitude_latitude_that_geopandas_reads_back(files):
@@ -89,16 +93,16 @@ def test_geojson_is_longitude_latitude_that_geopandas_reads_back(files):
     gpd = pytest.importorskip("geopandas")
     out = files["dir"] / "objects.geojson"
     run("detect", files["img"], "--hologram", files["holo"], "-o", out, "--force", "-q",
-        "--crs", UTM33)
+        "--crs", LOCAL)
     doc = json.loads(out.read_text())
     assert doc["type"] == "FeatureCollection" and "crs" not in doc
-    assert doc["crs_of_properties"]["crs"].startswith("EPSG:32633")
+    assert doc["crs_of_properties"]["crs"].startswith("EPSG:3857")
     feats = doc["features"]
     assert [f["geometry"]["type"] for f in feats] == ["Point", "Point"]
     _same(_from_records([f["properties"] for f in feats])[files["ref"].columns], files["ref"])
     g = gpd.read_file(out)
     assert g.crs.to_epsg() == 4326
-    back = g.to_crs(UTM33)
+    back = g.to_crs(LOCAL)
     np.testing.assert_allclose(back.geometry.x, files["ref"].x, rtol=0, atol=0.01)
     np.testing.assert_allclose(back.geometry.y, files["ref"].y, rtol=0, atol=0.01)
 
@@ -129,7 +133,7 @@ def test_geojson_lines_and_areas():
          "y_end": 0.0, "length": 0.2, "width": 0.0, "azimuth_deg": 0.0},
         {"kind": "area", "x": 1.0, "y": 2.0, "x_start": np.nan, "y_start": np.nan,
          "x_end": np.nan, "y_end": np.nan, "length": 0.4, "width": 0.2, "azimuth_deg": 90.0}])
-    line, area = geojson(df, {}, "scene", UTM33)["features"]
+    line, area = geojson(df, {}, "scene", LOCAL)["features"]
     assert line["geometry"]["type"] == "LineString"
     ring = np.array(area["properties"]["outline_xy"])
     assert area["geometry"]["type"] == "Polygon" and np.allclose(ring[0], ring[-1])
@@ -152,7 +156,7 @@ def test_a_table_of_several_kinds_is_one_geometry_type_per_file(tmp_path):
         {"kind": "point", "x": 0.3, "y": 0.1, "x_start": np.nan, "y_start": np.nan,
          "x_end": np.nan, "y_end": np.nan, "length": 0.0, "azimuth_deg": np.nan}])
     out = tmp_path / "o.geojson"
-    written = write(out, df, {}, "scene", UTM33)
+    written = write(out, df, {}, "scene", LOCAL)
     assert [p.name for p in written] == ["o.geojson", "o_points.geojson", "o_lines.geojson"]
     for p, types in zip(written, (["Point"], ["Point"], ["LineString"]), strict=True):
         g = gpd.read_file(p)
@@ -195,7 +199,7 @@ def test_geojson_area_is_detects_outline(tmp_path):
                     9.9e9, include_surface=False, snr_db=30, seed=1)
     img = hr.save(hr.migrate(h, 0.40, medium=SAND, upsample=4), tmp_path / "plate.nc")
     out = tmp_path / "plate.geojson"
-    run("detect", img, *GROUND, "-o", out, "-q", "--crs", UTM33)
+    run("detect", img, *GROUND, "-o", out, "-q", "--crs", LOCAL)
     ref = hr.detect(hr.load(img), medium=SAND)
     assert list(ref.kind) == ["area"]
     (feat,) = json.loads(out.read_text())["features"]
@@ -211,7 +215,7 @@ def test_geojson_closes_an_open_outline():
     df = pd.DataFrame([{"kind": "area", "x": 0.5, "y": 0.5, "length": 1.0, "width": 1.0,
                         "azimuth_deg": 0.0}])
     df.attrs["outlines"] = {0: [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]}
-    (area,) = geojson(df, {}, "scene", UTM33)["features"]
+    (area,) = geojson(df, {}, "scene", LOCAL)["features"]
     assert area["properties"]["outline_xy"] == [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0],
                                                 [0.0, 0.0]]
     ring = area["geometry"]["coordinates"][0]
@@ -326,7 +330,7 @@ def test_survey_objects_in_survey_coordinates_once(survey, mode):
     d, z0 = survey["dir"], survey["z0"]
     plane = [] if mode == "hologram" else ["--z", f"{survey['plane']:g}"]
     out = d / f"objects_{mode}.geojson"
-    run("detect", d / "s.zarr", *plane, "-o", out, "--force", "--crs", UTM33)
+    run("detect", d / "s.zarr", *plane, "-o", out, "--force", "--crs", LOCAL)
     doc = json.loads(out.read_text())
     feats = doc["features"]
     assert len(feats) == 1, [f["properties"] for f in feats]   # seen by both frames: once
@@ -337,7 +341,7 @@ def test_survey_objects_in_survey_coordinates_once(survey, mode):
     from holoradar.io.crs import as_crs, to_lonlat
 
     assert feats[0]["geometry"]["coordinates"] == pytest.approx(
-        list(to_lonlat(p["x"], p["y"], as_crs(UTM33))), abs=1e-12)
+        list(to_lonlat(p["x"], p["y"], as_crs(LOCAL))), abs=1e-12)
     assert p["frame"] == "frame0.nc"       # the frame it lies nearest the centre of
     per_frame = doc["metadata"]["per_frame"]
     # One frequency: no finite range cell (null); the lateral cell bounds the depth.
@@ -364,7 +368,7 @@ def test_survey_geojson_area_is_the_frames_outline(tmp_path):
     hr.survey.run_batch([frame], store, z=[0.35], medium=SAND, upsample=4,
                         scheduler="synchronous")
     out = tmp_path / "plate.geojson"
-    run("detect", store, "--z", "0.35", "-o", out, "-q", "--crs", UTM33)
+    run("detect", store, "--z", "0.35", "-o", out, "-q", "--crs", LOCAL)
     seen = hr.Medium.half_space(0.25, SAND.eps[1])
     ref = hr.detect(hr.survey.frame_image(store, 0).plane(0.35), medium=seen)
     assert list(ref.kind) == ["area"] and ref.depth[0] == pytest.approx(0.10, abs=0.01)
@@ -397,3 +401,31 @@ def test_survey_refuses_ground_flags_and_hologram(survey, files):
     one_line_error(run("detect", store, *GROUND, ok=False), "--eps/--z-surface")
     one_line_error(run("detect", store, "--hologram", files["holo"], ok=False),
                    "--hologram")
+
+
+def test_local_positions_are_refused_in_a_crs_and_placed_by_origin(tmp_path):
+    # An image's axes are local metres: written as eastings and northings of UTM 33N
+    # they would land at 10.5 E on the equator. Refused, naming --origin; with --origin
+    # (and --azimuth) the object lands where the local grid puts it, to the metre.
+    import json
+
+    import pyproj
+
+    from cli_helpers import one_line_error, run
+
+    scene = hr.Scene(hr.Medium.free_space(), hr.PlaneWave(),
+                     [hr.PointTarget((0.02, 0.0, 0.5))])
+    h = hr.simulate(scene, hr.Aperture.grid(24, 0.0125), 9.9e9, snr_db=30, seed=1)
+    img = hr.save(hr.migrate(h, 0.5, upsample=4), tmp_path / "img.nc")
+    out = tmp_path / "o.geojson"
+    one_line_error(run("detect", img, "--crs", "EPSG:32633", "-o", out, ok=False),
+                   "outside the area of use", "--origin")
+    assert not out.exists()
+    run("detect", img, "--crs", "EPSG:32633", "--origin", "500000,4649776", "--azimuth", "90",
+        "-o", out)
+    feature = json.loads(out.read_text())["features"][0]
+    # +y at 90 degrees (east): local (x, y) = (0.02, 0) is 0.02 m south of the origin.
+    lon, lat = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True) \
+        .transform(500000.0, 4649776.0 - 0.02)
+    got = feature["geometry"]["coordinates"]
+    assert abs(got[0] - lon) < 2 / 111e3 and abs(got[1] - lat) < 2 / 111e3

@@ -70,7 +70,7 @@ def geojson(df: Any, metadata: dict[str, Any], frame: str, crs: Any = None,
     >>> g["type"], [round(v, 9) for v in g["coordinates"]]
     ('Point', [15.0, 0.0])
     """
-    from .crs import as_crs, crs_name, to_lonlat
+    from .crs import as_crs, check_area_of_use, crs_name, to_lonlat
 
     if crs is None:
         raise ValueError("GeoJSON (RFC 7946) holds WGS 84 longitude and latitude, and the "
@@ -78,6 +78,9 @@ def geojson(df: Any, metadata: dict[str, Any], frame: str, crs: Any = None,
                          "(--crs EPSG:..., the projected CRS of the frames' positions), or "
                          "write .csv or .json (metres on the image's axes)")
     crs = as_crs(crs)
+    if len(df):
+        check_area_of_use(df["x"].to_numpy(float), df["y"].to_numpy(float), crs,
+                          "the objects' positions")
     features = []
     outlines = df.attrs.get("outlines") or {}
     for n, row in enumerate(records(df)):

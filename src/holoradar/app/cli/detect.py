@@ -236,11 +236,19 @@ def detection_options(f: Any) -> Any:
                    "survey's own; a table of several kinds also as one file per kind).")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
 @crs_option
+@click.option("--origin", default=None, metavar="E,N",
+              help="A local survey placed in --crs: the easting and northing (the CRS's "
+                   "units, metres) of its (0, 0); the positions written are then eastings "
+                   "and northings.")
+@click.option("--azimuth", type=float, default=0.0, show_default=True,
+              help="With --origin: the bearing of the survey's +y axis, degrees clockwise "
+                   "from north (0: +y north, +x east).")
 @layout_option
 @output_options
 def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval: str | None,
            false_alarm: str, kinds: str, hologram: Path | None, out: Path | None, force: bool,
-           crs: Any, layout: str | None, check: bool, report: Reporter) -> None:
+           crs: Any, origin: str | None, azimuth: float, layout: str | None, check: bool,
+           report: Reporter) -> None:
     """List the objects in an image, a hologram or a survey store.
 
     FILE: an image (holoradar image/mosaic), a hologram (imaged on --z first) or a
@@ -265,6 +273,7 @@ def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval:
         raise click.BadParameter("a survey store's frames are fitted with their own "
                                  "holograms: give no --hologram", param_hint="--hologram")
     crs = _positions_crs(file, store, crs, out)
+    placed = _origin(origin, azimuth, crs)
     if store:
         df, info, medium = _from_store(file, z, medium_spec, full, report)
         frame = "survey: x, y are world metres (the frames' positions plus pixel offsets)"
@@ -272,7 +281,56 @@ def detect(file: Path, z: str | None, medium_spec: dict[str, Any], eps_interval:
         df, info, medium = _from_file(file, z, medium_spec, full, hologram, layout, check,
                                       report)
         frame = "scene: x, y are metres on the image's axes"
+    if placed is not None:
+        df = _placed(df, *placed)
+        info["origin"] = {"easting_northing_m": list(placed[0]), "azimuth_deg": placed[1]}
+        frame += f"; placed in the CRS: (0, 0) at E {placed[0][0]:.3f} N {placed[0][1]:.3f}, " \
+                 f"+y at {placed[1]:g} degrees from north"
     _done(file, df, info, medium, args, interval, out, frame, report, crs, force)
+
+
+def _origin(origin: str | None, azimuth: float, crs: Any
+            ) -> tuple[tuple[float, float], float] | None:
+    """``--origin E,N`` (and ``--azimuth``), checked: it needs a CRS."""
+    if origin is None:
+        if azimuth != 0.0:
+            raise click.BadParameter("--azimuth turns a local survey placed by --origin: "
+                                     "give --origin E,N too", param_hint="--azimuth")
+        return None
+    try:
+        e, n = (float(v) for v in origin.split(","))
+    except ValueError:
+        raise click.BadParameter(f"expected E,N (easting and northing in metres), got "
+                                 f"{origin!r}", param_hint="--origin") from None
+    if crs is None:
+        raise click.BadParameter("places the survey in a CRS: give --crs EPSG:... too",
+                                 param_hint="--origin")
+    if not (np.isfinite(e) and np.isfinite(n) and np.isfinite(azimuth)):
+        raise click.BadParameter(f"must be finite, got {origin!r}", param_hint="--origin")
+    return (e, n), float(azimuth)
+
+
+def _placed(df: Any, origin: tuple[float, float], azimuth: float) -> Any:
+    """The table with its positions (centres, line ends, outlines) as eastings and
+    northings, and its azimuths as bearings turned with the grid."""
+    from ...io.crs import from_local
+
+    out = df.copy()
+    for xk, yk in (("x", "y"), ("x_start", "y_start"), ("x_end", "y_end")):
+        if xk in out and yk in out:
+            out[xk], out[yk] = from_local(out[xk].to_numpy(float), out[yk].to_numpy(float),
+                                          origin, azimuth)
+    if "azimuth_deg" in out:
+        # From +x towards +y, turned with the grid (a rotation by -azimuth).
+        out["azimuth_deg"] = (out["azimuth_deg"] - azimuth) % 180.0
+    outlines = df.attrs.get("outlines") or {}
+    out.attrs = dict(df.attrs)
+    if outlines:
+        out.attrs["outlines"] = {k: [list(from_local([u], [v], origin, azimuth))
+                                     for u, v in ring] for k, ring in outlines.items()}
+        out.attrs["outlines"] = {k: [[float(p[0][0]), float(p[1][0])] for p in ring]
+                                 for k, ring in out.attrs["outlines"].items()}
+    return out
 
 
 def _positions_crs(file: Path, store: bool, crs: Any, out: Path | None) -> Any:
