@@ -500,7 +500,8 @@ def describe_store(target: Path, checksums: bool = True) -> dict[str, Any]:
         (of the I and Q values),
         ``compressors`` (names; empty for a store written before compression),
         ``extent_m`` (x min, x max, y min, y max of the stored frames' centres;
-        None if none) and ``bytes_on_disk``.
+        None if none), ``bytes_on_disk`` and ``georeferenced`` (the CRS of the frames'
+        positions, ``"EPSG:..."``, or None: local metres).
 
     Examples
     --------
@@ -568,6 +569,9 @@ def describe_store(target: Path, checksums: bool = True) -> dict[str, Any]:
         "extent_m": [float(fx.min()), float(fx.max()), float(fy.min()), float(fy.max())]
         if fx.size and fy.size else None,
         "bytes_on_disk": sum(f.stat().st_size for f in Path(target).rglob("*") if f.is_file()),
+        # Whether the frames' positions are eastings and northings of a known CRS (a map
+        # can place them) or a local survey's metres.
+        "georeferenced": attrs.get("crs"),
     }
 
 

@@ -205,6 +205,8 @@ def store_info(path: Path) -> tuple[dict[str, Any], list[str]]:
     if d["extent_m"] is not None:
         x0, x1, y0, y1 = d["extent_m"]
         rows.append(("frame centres", f"x {x0:.4g} .. {x1:.4g} m, y {y0:.4g} .. {y1:.4g} m"))
+    rows.append(("positions", f"georeferenced, {d['georeferenced']}" if d["georeferenced"]
+                 else "local metres (no CRS: holoradar batch --crs, or detect --origin)"))
     rows.append(("created", str(d["created"])))
     lines = [f"{path.name}: a holoradar survey store ({bytes_text(d['bytes_on_disk'])} "
              "on disk)"]
