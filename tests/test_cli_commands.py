@@ -326,18 +326,23 @@ def test_batch_and_mosaic_from_the_command_line(tmp_path):
     assert json.loads(res.stdout)["resumed"] == 3
     one_line_error(run("batch", pattern, "-o", store, "--z", "0.35", "--scheduler",
                        "synchronous", ok=False), "other settings")
-    res = run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc", "--json")
+    res = run("mosaic", store, "--range", "0.3", "-o", tmp_path / "map.nc", "--json")
     peak = json.loads(res.stdout)["peak_m"]
     # The stone at x = 0.12 m: within one map pixel (pitch / upsample = 5 mm).
     assert abs(peak[0] - 0.12) <= 0.005 and abs(peak[1]) <= 0.005
-    run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.png", "-q")
-    # A depth outside the stored planes took the nearest plane without a word.
-    one_line_error(run("mosaic", store, "--depth", "30", "-o", tmp_path / "m30.png", ok=False),
-                   "--depth", "30 m is outside the stored planes 0.3 m", "centimetres",
-                   "--depth 0.3")
-    one_line_error(run("mosaic", store, "--depth", "0.80", "-o", tmp_path / "m80.png",
+    run("mosaic", store, "--range", "0.3", "-o", tmp_path / "map.png", "-q")
+    # A range outside the stored planes took the nearest plane without a word.
+    one_line_error(run("mosaic", store, "--range", "30", "-o", tmp_path / "m30.png", ok=False),
+                   "--range", "30 m is outside the stored planes 0.3 m", "centimetres",
+                   "--range 0.3")
+    # A depth is below the surface: with --z-surface it names the same plane; alone it
+    # is refused with the way out (the option was a range under a depth's name).
+    run("mosaic", store, "--depth", "0.1", "--z-surface", "0.2", "-o", tmp_path / "md.nc")
+    one_line_error(run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "mx.png", ok=False),
+                   "--depth", "--z-surface", "--range")
+    one_line_error(run("mosaic", store, "--range", "0.80", "-o", tmp_path / "m80.png",
                        ok=False), "0.8 m is outside the stored planes 0.3 m")
-    res = run("mosaic", store, "--depth", "0.3", "--z-surface", "0.4", "-o",
+    res = run("mosaic", store, "--range", "0.3", "--z-surface", "0.4", "-o",
               tmp_path / "m40.png", "-q")
     assert "warning: --z-surface 0.4 m lies beyond the mapped plane" in res.output
     # Ranges against the frames' array (12 x 1 cm at 9.9 GHz: nothing focuses beyond 0.48 m),

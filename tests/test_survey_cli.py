@@ -224,7 +224,7 @@ def test_mosaic_file_is_an_amplitude_and_one_panel_says_so(survey: list[Path],
 
     store = tmp_path / "s.zarr"
     hr.survey.run_batch(survey[:3], store, z=[0.3], scheduler="synchronous")
-    run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc")
+    run("mosaic", store, "--range", "0.3", "-o", tmp_path / "map.nc")
     with h5py.File(tmp_path / "map.nc") as f:
         assert f["image"].dtype == np.float64 and "iq" not in f
     m = hr.load(tmp_path / "map.nc")
@@ -256,7 +256,7 @@ def test_every_command_names_a_damaged_frame_with_exit_2(survey: list[Path], tmp
     else:
         blob[len(blob) // 2] ^= 0x10
         chunk.write_bytes(bytes(blob))
-    for args in (("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc"),
+    for args in (("mosaic", store, "--range", "0.3", "-o", tmp_path / "map.nc"),
                  ("detect", store), ("detect", store, "--z", "0.3"),
                  ("report", store, "-o", tmp_path / "r.html"), ("info", store)):
         res = run(*args, ok=False)
@@ -265,5 +265,5 @@ def test_every_command_names_a_damaged_frame_with_exit_2(survey: list[Path], tmp
     assert not (tmp_path / "map.nc").exists() and not (tmp_path / "r.html").exists()
     # A rerun of the batch images the damaged frame again: every command reads it.
     hr.survey.run_batch(survey[:3], store, z=[0.3], scheduler="synchronous")
-    run("mosaic", store, "--depth", "0.3", "-o", tmp_path / "map.nc")
+    run("mosaic", store, "--range", "0.3", "-o", tmp_path / "map.nc")
     run("info", store)

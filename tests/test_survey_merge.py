@@ -150,7 +150,7 @@ def test_a_damaged_chunk_is_named_by_its_frames_not_a_crash(tmp_path):
     b = bytearray(open(chunks[0], "rb").read())
     b[len(b) // 2] ^= 0xFF
     open(chunks[0], "wb").write(bytes(b))
-    res = run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m.nc", ok=False)
+    res = run("mosaic", store, "--range", "0.2", "-o", tmp_path / "m.nc", ok=False)
     one_line_error(res, "damaged", "f0.nc")
     assert not (tmp_path / "m.nc").exists()
     one_line_error(run("detect", store, "--z", "0.2", ok=False), "damaged", "f0.nc")
@@ -163,12 +163,12 @@ def test_a_damaged_chunk_is_named_by_its_frames_not_a_crash(tmp_path):
     # a rerun images the damaged frame again: the store is whole
     s = hr.survey.run_batch(paths, store, z=[0.2], scheduler="synchronous")
     assert s["done"] >= 1 and hr.survey.describe_store(store)["damaged"] == []
-    run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m.nc")
+    run("mosaic", store, "--range", "0.2", "-o", tmp_path / "m.nc")
     # a missing chunk: named by mosaic, not drawn as a blank hole
     import os
 
     os.remove(chunks[-1])
-    one_line_error(run("mosaic", store, "--depth", "0.2", "-o", tmp_path / "m2.nc",
+    one_line_error(run("mosaic", store, "--range", "0.2", "-o", tmp_path / "m2.nc",
                        ok=False), "damaged", "f3.nc", "missing")
 
 

@@ -234,17 +234,18 @@ def _first_frame(files: list[Path], layout: str | None) -> Any:
         return None
 
 
-def _check_mosaic_options(store: Path, depth: float, z_surface: float | None) -> None:
-    """Refuse a --depth outside the stored planes (the nearest plane would be mapped
-    silently) and a --z-surface no frame's array can focus; warn when the surface lies
-    beyond the mapped plane."""
+def _check_mosaic_options(store: Path, depth: float, z_surface: float | None,
+                          name: str = "--range") -> None:
+    """Refuse a plane (``name``: --range or --depth) outside the stored planes (the
+    nearest plane would be mapped silently) and a --z-surface no frame's array can
+    focus; warn when the surface lies beyond the mapped plane."""
     from ...data.plausibility import PlausibilityWarning
     from ...survey.store import is_survey, stored_settings
 
     if not is_survey(store):
         return  # the mosaic names what the folder lacks
     settings, geometry = stored_settings(store)
-    refuse_outside_planes(depth, settings.z, "--depth", "stored planes")
+    refuse_outside_planes(depth, settings.z, name, "stored planes")
     if z_surface is None:
         return
     aperture = max(geometry.nx * abs(geometry.pitch[0]), geometry.ny * abs(geometry.pitch[1]))
@@ -261,9 +262,12 @@ def _check_mosaic_options(store: Path, depth: float, z_surface: float | None) ->
 
 @click.command()
 @click.argument("store", type=click.Path(exists=True, file_okay=False, path_type=Path))
-@click.option("--depth", required=True, type=float,
-              help="Range of the plane (m); the stored plane nearest to it is used (one "
-                   "outside the stored planes is refused).")
+@click.option("--range", "range_m", type=float, default=None,
+              help="Range of the plane from the arrays (m); the stored plane nearest to it "
+                   "is used (one outside the stored planes is refused).")
+@click.option("--depth", type=float, default=None,
+              help="Or the plane's depth below the ground's surface (m): needs --z-surface "
+                   "(the range is --z-surface + --depth).")
 @click.option("--pitch", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Pixel step of the map, m (default: the frames' pixel step).")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
@@ -274,21 +278,34 @@ def _check_mosaic_options(store: Path, depth: float, z_surface: float | None) ->
               help="Ground surface range, m: label the plane with its depth below it.")
 @click.option("--force", is_flag=True, help="Replace --out if it exists.")
 @output_options
-def mosaic(store: Path, depth: float, pitch: float | None, out: Path, db_range: float | None,
-           z_surface: float | None, force: bool, report: Reporter) -> None:
-    """Stitch a survey store into one plan-view map at a depth, overlapping frames blended."""
+def mosaic(store: Path, range_m: float | None, depth: float | None, pitch: float | None,
+           out: Path, db_range: float | None, z_surface: float | None, force: bool,
+           report: Reporter) -> None:
+    """Stitch a survey store into one plan-view map at a range (or a depth below the
+    surface), overlapping frames blended."""
     from ...io import save
     from ...io.output import check_output
     from ...survey import mosaic as run
     from .. import plotting
     from ..atomic import write_atomic
 
+    if (range_m is None) == (depth is None):
+        raise click.BadParameter("give the plane as --range R (from the arrays, m) or as "
+                                 "--depth D (below the ground's surface, m, with "
+                                 "--z-surface)", param_hint="--range/--depth")
+    if depth is not None and z_surface is None:
+        raise click.BadParameter("a depth is below the ground's surface: give --z-surface "
+                                 "(its range from the arrays), or --range for a range from "
+                                 "the arrays", param_hint="--depth")
+    name = "--range" if depth is None else "--depth"
+    plane = range_m if depth is None else z_surface + depth
     check_output(out, suffixes=[".png", ".nc"], inputs=[store], overwrite=force, name="--out")
-    _check_mosaic_options(store, depth, z_surface)
-    img = run(store, depth, pitch=pitch)
+    _check_mosaic_options(store, plane, z_surface, name)
+    img = run(store, plane, pitch=pitch)
     if out.suffix.lower() == ".nc":
         save(img, out, overwrite=force, history=[{"step": "mosaic", "input": store.name,
-                                                  "parameters": {"depth": depth,
+                                                  "parameters": {"range": plane,
+                                                                 "depth": depth,
                                                                  "pitch": pitch}}])
     else:
         fig = plotting.plot_planes(img, [float(img.z[0])], db_range=db_range,
