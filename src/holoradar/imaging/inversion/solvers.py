@@ -163,12 +163,18 @@ def _largest_eigenvalue(B: Any, progress: Any, steps: int = 30) -> float:
     v = rng.standard_normal(B.shape[1]) + 1j * rng.standard_normal(B.shape[1])
     v = v / np.linalg.norm(v)
     lam = 0.0
-    for _ in range(steps):
-        w = B.rmatvec(B.matvec(v))
-        new = float(np.linalg.norm(w))
-        v = w / max(new, 1e-300)
-        if lam and abs(new - lam) < 1e-3 * new:
+    # Seconds on a large grid before the solver's own bar: said on a terminal too.
+    bar = _bar(progress, steps, "invert (step size)")
+    try:
+        for _ in range(steps):
+            w = B.rmatvec(B.matvec(v))
+            new = float(np.linalg.norm(w))
+            v = w / max(new, 1e-300)
+            bar.update(1)
+            if lam and abs(new - lam) < 1e-3 * new:
+                lam = new
+                break
             lam = new
-            break
-        lam = new
+    finally:
+        bar.close()
     return 1.01 * lam   # a little above: FISTA's step must stay below 1/L
