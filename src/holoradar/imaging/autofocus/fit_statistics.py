@@ -106,11 +106,18 @@ def _sandwich(search: Search, eps: float, z: float, xy: np.ndarray, g: np.ndarra
     for sel in groups:  # each amplitude: its phase, and for a field fit its modulus
         t = np.where(sel[:, None], m0, 0)
         tangents += [1j * t] if pr.phase_only else [t, 1j * t]
-    steps = [dx, dx, 1e-3, dx][:len(xy)]  # x, y (and a line's azimuth, length)
+    # x, y (and a line's azimuth, length, or a sphere's radius: 1e-3 of it or of a
+    # radian, whichever is the smaller, so that a small sphere's radius stays > 0).
+    third = min(1e-3, 1e-3 * abs(float(xy[2]))) if len(xy) > 2 and xy[2] != 0 else 1e-3
+    steps = [dx, dx, third, dx][:len(xy)]
     for i, step in enumerate(steps):
         dv = np.zeros(len(xy))
         dv[i] = step
-        tangents.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * step))
+        try:
+            tangents.append((model(eps, z, xy + dv) - model(eps, z, xy - dv)) / (2 * step))
+        except ValueError:
+            # Out of the model's domain on one side (a radius at 0): one-sided.
+            tangents.append((model(eps, z, xy + dv) - m0) / step)
     tangents.append((model(eps, z + dz, xy) - model(eps, z - dz, xy)) / (2 * dz))
     T = np.stack([np.concatenate([t.real.ravel(), t.imag.ravel()]) for t in tangents], 1)
     d = np.concatenate([d_eps.real.ravel(), d_eps.imag.ravel()])
