@@ -403,29 +403,27 @@ def test_survey_refuses_ground_flags_and_hologram(survey, files):
                    "--hologram")
 
 
-def test_local_positions_are_refused_in_a_crs_and_placed_by_origin(tmp_path):
+def test_local_positions_are_refused_in_a_crs_and_placed_by_origin(files, tmp_path):
     # An image's axes are local metres: written as eastings and northings of UTM 33N
     # they would land at 10.5 E on the equator. Refused, naming --origin; with --origin
-    # (and --azimuth) the object lands where the local grid puts it, to the metre.
+    # (and --azimuth) each object lands where the local grid puts it, to the metre.
     import json
 
     import pyproj
 
     from cli_helpers import one_line_error, run
 
-    scene = hr.Scene(hr.Medium.free_space(), hr.PlaneWave(),
-                     [hr.PointTarget((0.02, 0.0, 0.5))])
-    h = hr.simulate(scene, hr.Aperture.grid(24, 0.0125), 9.9e9, snr_db=30, seed=1)
-    img = hr.save(hr.migrate(h, 0.5, upsample=4), tmp_path / "img.nc")
+    img, ref = files["img"], files["ref"]
     out = tmp_path / "o.geojson"
-    one_line_error(run("detect", img, "--crs", "EPSG:32633", "-o", out, ok=False),
+    one_line_error(run("detect", img, *GROUND, "--crs", "EPSG:32633", "-o", out, ok=False),
                    "outside the area of use", "--origin")
     assert not out.exists()
-    run("detect", img, "--crs", "EPSG:32633", "--origin", "500000,4649776", "--azimuth", "90",
-        "-o", out)
-    feature = json.loads(out.read_text())["features"][0]
-    # +y at 90 degrees (east): local (x, y) = (0.02, 0) is 0.02 m south of the origin.
-    lon, lat = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True) \
-        .transform(500000.0, 4649776.0 - 0.02)
-    got = feature["geometry"]["coordinates"]
-    assert abs(got[0] - lon) < 2 / 111e3 and abs(got[1] - lat) < 2 / 111e3
+    run("detect", img, *GROUND, "--crs", "EPSG:32633", "--origin", "500000,4649776",
+        "--azimuth", "90", "-o", out, "-q")
+    features = json.loads(out.read_text())["features"]
+    to_lonlat = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True)
+    for feature, (x, y) in zip(features, zip(ref.x, ref.y, strict=True), strict=True):
+        # +y at 90 degrees (east): local (x, y) is E0 + y, N0 - x.
+        lon, lat = to_lonlat.transform(500000.0 + y, 4649776.0 - x)
+        got = feature["geometry"]["coordinates"]
+        assert abs(got[0] - lon) < 2 / 111e3 and abs(got[1] - lat) < 2 / 111e3

@@ -233,10 +233,10 @@ def test_line_scans_go_into_a_survey_store_and_its_map_has_a_row_per_line(tmp_pa
     # y, each bar within a pitch of its x.
     ground = hr.Medium.half_space(0.0, EPS)
     bars = [hr.LineTarget((x, -3.0, 0.10), (x, 3.0, 0.10), RADIUS) for x in (-0.2, 0.0, 0.2)]
-    f = np.linspace(0.98e9, 2.0e9, 32)
+    f = np.linspace(0.98e9, 2.0e9, 16)
     paths = []
     for i, (x0, y0) in enumerate(((0.0, 0.0), (0.05, 0.1), (-0.03, 0.25))):
-        ap = hr.Aperture.grid(50, PITCH, ny=1, monostatic=True, pose=hr.Pose((x0, y0, 0.0)))
+        ap = hr.Aperture.grid(40, PITCH, ny=1, monostatic=True, pose=hr.Pose((x0, y0, 0.0)))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             h = hr.simulate(hr.Scene(ground, targets=bars), ap, f, include_surface=False,

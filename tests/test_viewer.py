@@ -475,7 +475,7 @@ def test_objects_files_of_holoradar_detect_are_read_back(tmp_path):
     df = _objects_table()
     for suffix in (".csv", ".json", ".geojson"):
         p = tmp_path / f"objects{suffix}"
-        _write(p, df, {"input": "test"}, "scene", "EPSG:32633")
+        _write(p, df, {"input": "test"}, "scene", "EPSG:3857")
         back = read_objects(p)
         assert list(back["kind"]) == ["point", "line", "area"], suffix
         for c in ("x", "y", "range", "depth", "x_start", "snr_db"):
