@@ -7,6 +7,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import holoradar as hr
 from holoradar.analysis.detect.ringing import absorb_ringing
@@ -41,6 +42,7 @@ def test_smuthi_sphere_is_one_point_at_its_centre_from_the_plane():
     assert abs(df.x[0]) < lateral / 4 and abs(df.y[0]) < lateral / 4
 
 
+@pytest.mark.slow   # full-wave: the SMUTHI sphere's volume, 9 s (the plane case stays fast)
 def test_smuthi_sphere_is_one_point_at_its_centre_from_the_volume():
     # With the hologram: the fitted range within a quarter of the one-frequency focus
     # (the longitudinal resolution) of the centre.

@@ -169,6 +169,7 @@ def test_cli_fits_the_sphere_and_names_a_radius_without_the_sphere(tmp_path):
     one_line_error(res, "--sphere-radius")
 
 
+@pytest.mark.slow   # full-wave (the SMUTHI sphere fitted as a point, then as a sphere: 11 s)
 def test_a_point_fit_turns_to_a_sphere_where_the_data_say_so():
     """The default (point) fit of the T-matrix ball: the point leaves 1.1e-3 of the field
     unexplained, smooth across the aperture; a sphere of fitted radius explains all but
