@@ -251,3 +251,26 @@ def test_line_scans_go_into_a_survey_store_and_its_map_has_a_row_per_line(tmp_pa
         for xb in (-0.2, 0.0, 0.2):
             near = np.abs(m.x - xb) < 0.05
             assert abs(m.x[near][np.argmax(row[near])] - xb) <= PITCH
+
+
+def test_the_layout_keys_a_transceiver_on_the_axes_not_on_one_row(tmp_path):
+    # A grid file with one row is a receiver array's unless it says otherwise; a line
+    # declared by its axes (fx, or x alone at one frequency) is a transceiver's.
+    x = np.arange(8) * 0.01
+    np.savez(tmp_path / "row.npz", E=np.ones((1, 8)) + 0j, x=x, y=[0.05], frequency=9.9e9)
+    assert not hr.load(tmp_path / "row.npz", layout="data=E", check=False).monostatic
+    np.savez(tmp_path / "line.npz", E=np.ones(8) + 0j, x=x, frequency=9.9e9)
+    h = hr.load(tmp_path / "line.npz", layout="data=E,axes=x", check=False)
+    assert h.is_line and h.monostatic and h.data.shape == (1, 8)
+
+
+def test_a_flat_scan_has_no_sign_and_a_one_frequency_section_no_objects():
+    # Data the same at every position hold nothing compact once the flat part is out:
+    # the sharpness is 0 on both sides (not NaN), and the tie reads as recorded.
+    x = np.arange(16) * 0.01
+    h = hr.Hologram(np.full((16, 16), 1 + 1j), x, x, 9.9e9, monostatic=True)
+    assert hr.iq_convention(h, [0.1, 0.2]) == "I+iQ"
+    line = hr.Hologram(np.ones(16) + 0j, x, frequency=9.9e9, monostatic=True)
+    img = hr.migrate(line, np.linspace(0.05, 0.3, 6))
+    with pytest.raises(ValueError, match="one frequency has no range focus|no range focus"):
+        hr.detect(img)

@@ -100,8 +100,11 @@ class IQSignCheck:
 
 
 def _sharpness(data: np.ndarray) -> float:
-    a = np.abs(data) ** 2
-    return float(a.max() / max(a.mean(), 1e-300))
+    """Peak over mean intensity (double precision: a single-precision image's mean may
+    underflow the floor; all-zero data are 0, not NaN)."""
+    a = np.abs(np.asarray(data)).astype(np.float64) ** 2
+    mean = float(a.mean()) if a.size else 0.0
+    return float(a.max()) / mean if mean > 0 else 0.0
 
 
 def _spread(values: np.ndarray, n: int) -> np.ndarray:

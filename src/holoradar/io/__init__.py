@@ -243,7 +243,7 @@ def _warn_non_finite(img: Image, what: str) -> None:
     if bad:
         warnings.warn(f"{what}: {bad} of {data.size} samples are NaN or infinite (a damaged "
                       "file?): they show blank and are left out of peaks and levels",
-                      NonFiniteWarning, stacklevel=3)
+                      NonFiniteWarning, stacklevel=4)
 
 
 def _response(lay: Layout | None, src: Path) -> Path | None:

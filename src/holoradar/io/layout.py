@@ -492,11 +492,13 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
     if lay.iq_sign == "I-iQ":
         field = np.conj(field) if field.dtype.kind == "c" else field
     x_ref, y_ref = lay.x or _find(variables, "x"), lay.y or _find(variables, "y")
-    if field.ndim == 1 and (x_ref is None or y_ref is None):
+    declared_line = lay.axes is not None and "y" not in lay.axes and \
+        len(lay.axes) == field.ndim
+    if field.ndim == 1 and not declared_line and (x_ref is None or y_ref is None):
         raise ValueError(f"{what}: the field is one column ({field.size} values): a table "
                          "needs x and y columns too; name them with the layout (x=..., "
                          f"y=...). Found: {_describe(variables)}")
-    if field.ndim == 1:
+    if field.ndim == 1 and not declared_line:
         xs = _coordinate(variables, lay, "x", 0, what)
         ys = _coordinate(variables, lay, "y", 0, what)
         assert xs is not None and ys is not None
@@ -567,7 +569,8 @@ def assemble(variables: Mapping[str, np.ndarray], layout: Layout | None = None,
 def _hologram(field: np.ndarray, x: np.ndarray, y: np.ndarray, f: Any, lay: Layout,
               what: str) -> Hologram:
     try:
-        mono = lay.monostatic if lay.monostatic is not None else y.size == 1
+        line = lay.axes is not None and "y" not in lay.axes
+        mono = lay.monostatic if lay.monostatic is not None else line
         return Hologram(field, x, y, f, monostatic=mono,
                         tx_offset=layout_tx_offset(lay))
     except ValueError as exc:

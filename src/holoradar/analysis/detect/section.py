@@ -77,6 +77,11 @@ def detect_section(vol: Volume, medium: Any, false_alarm: float, max_objects: in
 
     from .multiples import split_multiples
 
+    if np.atleast_1d(vol.frequency).size < 2:
+        # One frequency has no range focus: a section's spots are its long range
+        # response, and the noise is not the correlated field the threshold assumes.
+        raise ValueError("image: a line scan's section at one frequency has no range "
+                         "focus to find objects in; image a band of frequencies")
     S = np.asarray(vol.data).reshape(vol.z.size, -1, vol.x.size)[:, 0, :]
     cell, rcell = section_cells(vol.x, vol.z, vol.frequency, medium)
     S, x = _fine(S, vol.x, cell)
