@@ -272,5 +272,5 @@ def test_a_flat_scan_has_no_sign_and_a_one_frequency_section_no_objects():
     assert hr.iq_convention(h, [0.1, 0.2]) == "I+iQ"
     line = hr.Hologram(np.ones(16) + 0j, x, frequency=9.9e9, monostatic=True)
     img = hr.migrate(line, np.linspace(0.05, 0.3, 6))
-    with pytest.raises(ValueError, match="one frequency has no range focus|no range focus"):
+    with pytest.raises(ValueError, match="no range focus"):
         hr.detect(img)
