@@ -74,6 +74,10 @@ class BoundedCache:
         ``replace``), the least recently used out beyond the bounds."""
         size = int(getattr(value, "nbytes", 0))
         if self.max_bytes is not None and size > self.max_bytes:
+            if replace:   # not kept, and what was kept under the key is stale
+                with self._lock:
+                    if key in self._data:
+                        self._bytes -= int(getattr(self._data.pop(key), "nbytes", 0))
             return
         with self._lock:
             if key in self._data:
