@@ -230,8 +230,7 @@ class Hologram(Band):
         """
         from .traces import frequency_samples
 
-        arr = np.asarray(traces) if not isinstance(traces, list) else traces
-        S, f = frequency_samples(arr, dt, band=band, time_zero=time_zero)
+        S, f = frequency_samples(traces, dt, band=band, time_zero=time_zero)
         if S.ndim != 2:
             raise ValueError(f"traces must be 2-D, (time samples, positions), got shape "
                              f"{np.shape(traces)}")

@@ -106,9 +106,9 @@ def _sandwich(search: Search, eps: float, z: float, xy: np.ndarray, g: np.ndarra
     for sel in groups:  # each amplitude: its phase, and for a field fit its modulus
         t = np.where(sel[:, None], m0, 0)
         tangents += [1j * t] if pr.phase_only else [t, 1j * t]
-    # x, y (and a line's azimuth, length, or a sphere's radius: 1e-3 of it or of a
-    # radian, whichever is the smaller, so that a small sphere's radius stays > 0).
-    third = min(1e-3, 1e-3 * abs(float(xy[2]))) if len(xy) > 2 and xy[2] != 0 else 1e-3
+    # x, y, and a line's azimuth (1e-3 rad) and length, or a sphere's radius (xy of
+    # three: 1e-3 of it, at most 1 mm, so that a small sphere's radius stays > 0).
+    third = min(1e-3, 1e-3 * abs(float(xy[2]))) if len(xy) == 3 and xy[2] != 0 else 1e-3
     steps = [dx, dx, third, dx][:len(xy)]
     for i, step in enumerate(steps):
         dv = np.zeros(len(xy))
