@@ -147,9 +147,9 @@ def test_image_command_warns_once_with_the_fix(tmp_path):
     res = CliRunner().invoke(main, ["image", str(tmp_path / "scan.npz"), *ground,
                                     "--layout", layout, "-o", str(tmp_path / "a.nc")])
     assert res.exit_code == 0, res.output
-    # one line (load's check and the image's are one warning), naming the layout's fix
+    # one line (the check at the planes imaged), naming the layout that fixes it
     assert res.output.count("(IQSignWarning)") == 1
-    assert "--layout '...,iq_sign=I-iQ'" in res.output
+    assert f"--layout {layout},iq_sign=I-iQ" in res.output
     res = CliRunner().invoke(main, ["image", str(tmp_path / "conj.nc"), *ground,
                                     "-o", str(tmp_path / "b.nc")])
     assert res.exit_code == 0 and res.output.count("(IQSignWarning)") == 1

@@ -78,6 +78,7 @@ def test_auto_equals_the_phase_shift_sum_on_every_grid(pad, upsample, z0):
 
 def test_auto_takes_the_compiled_loop_and_the_numpy_sum_without_numba(monkeypatch):
     h = _hologram(True, None, False, np.complex128)
+    columns.warm()   # loaded: auto takes it whatever the size of the work
     calls = []
     real = columns.adjoint_columns
     monkeypatch.setattr(columns, "adjoint_columns",
@@ -96,8 +97,9 @@ def test_warm_builds_every_loop_a_migration_calls(monkeypatch):
     # which numba types apart: warm() built writable ones, and a fresh install compiled
     # at its first wideband call). A new dispatcher (on numba's disk cache) sees only
     # what warm() and then the migrations ask of it.
-    fresh = columns._kernel.__wrapped__()
+    fresh = columns._build_kernel.__wrapped__()
     monkeypatch.setattr(columns, "_kernel", lambda: fresh)
+    monkeypatch.setattr(columns, "loaded", lambda: True)
     columns.warm()
     built = set(fresh.signatures)
     assert len(built) == 2
@@ -106,6 +108,30 @@ def test_warm_builds_every_loop_a_migration_calls(monkeypatch):
         for pad in (False, True):
             migrate64(h, ZS, pad=pad)
     assert set(fresh.signatures) == built
+
+
+def test_a_fresh_process_sums_small_work_in_numpy_until_loading_pays(monkeypatch):
+    # Loading numba and its cached loop costs a fresh process 0.35-0.45 s, the NumPy sum
+    # of COLD_LOAD_WORK multiply-adds as long: a small first migration takes NumPy; the
+    # work summed so adds up, and the call that would pass the bound loads the loop.
+    from holoradar.imaging.migration import choose
+
+    monkeypatch.setattr(columns, "loaded", lambda: False)
+    monkeypatch.setattr(choose, "_NUMPY_WORK", [0.0])
+    h = _hologram(True, None, False, np.complex128)
+    calls = []
+    real = columns.adjoint_columns
+    monkeypatch.setattr(columns, "adjoint_columns",
+                        lambda *a, **k: calls.append(1) or real(*a, **k))
+    a = migrate64(h, ZS)
+    assert calls == [] and choose._NUMPY_WORK[0] > 0
+    work = choose._NUMPY_WORK[0]
+    monkeypatch.setattr(choose, "COLD_LOAD_WORK", 2.5 * work)
+    migrate64(h.with_data(h.data), ZS)     # 2 x work: still NumPy
+    b = migrate64(h.with_data(h.data), ZS)  # 3 x work passes the bound: compiled
+    assert calls == [1]
+    # the two sums agree to rounding (the recurrence's j eps per plane)
+    assert _rel(a.data, b.data) < 10 * ZS.size * EPS[np.complex128]
 
 
 def test_auto_falls_back_to_the_per_frequency_sum_where_the_phase_shift_cannot():

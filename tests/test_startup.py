@@ -115,3 +115,34 @@ def test_the_public_names_agree_in_the_three_places_they_are_written():
                     static |= {a.asname or a.name for a in imp.names}
     lazy = set(hr._NAMES) | set(hr._SUBMODULES)
     assert static == lazy == set(hr.__all__), (static ^ lazy, lazy ^ set(hr.__all__))
+
+
+
+def test_image_command_on_a_band_imports_neither_xarray_dask_nor_numba(tmp_path):
+    # `holoradar image` on a user's scan, run once from a fresh process with the
+    # defaults: the NetCDF file is written through h5netcdf (xarray's import and its
+    # dask checks cost 0.6-1.2 s), and a band this small is summed in NumPy rather than
+    # loading numba and its compiled loop (0.35-0.45 s, more than the sum itself).
+    import numpy as np
+
+    rng = np.random.default_rng(0)
+    data = rng.standard_normal((5, 24, 20)) + 1j * rng.standard_normal((5, 24, 20))
+    np.savez(tmp_path / "scan.npz", data=data, x=np.arange(20) * 0.003,
+             y=np.arange(24) * 0.003, f=np.linspace(8e9, 12e9, 5))
+    probe = textwrap.dedent(f"""
+        import contextlib, io, json, sys, warnings
+        warnings.simplefilter("ignore")
+        sys.argv = ["holoradar", "image", {str(tmp_path / "scan.npz")!r}, "--layout",
+                    "data=data,x=x,y=y,frequency=f,axes=fyx,monostatic=true",
+                    "--z", "0.01:0.05:0.002", "--no-png", "-q",
+                    "-o", {str(tmp_path / "out.nc")!r}]
+        from holoradar.app.cli import main
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):
+            main()
+        watched = ("xarray", "pandas", "dask", "distributed", "numba", "matplotlib")
+        print(json.dumps([m for m in watched if m in sys.modules]))
+        """)
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, timeout=120).stdout
+    assert (tmp_path / "out.nc").exists()
+    assert json.loads(out.splitlines()[-1]) == []

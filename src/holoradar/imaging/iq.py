@@ -156,7 +156,7 @@ def _band_sides(hologram: Hologram, zs: np.ndarray, opts: dict[str, Any]) -> lis
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             img = migrate(conjugate(band) if flip else band, zs, upsample=1, pad=PAD,
-                          progress=False, combine="coherent", dtype=np.complex128, **opts)
+                          progress=False, combine="coherent", dtype=np.complex64, **opts)
         a = np.abs(np.asarray(img.data)) ** 2
         out.append(_sharpness(np.sqrt(a.reshape((-1, *a.shape[-3:])).sum(axis=0))))
     return out
@@ -293,7 +293,7 @@ def check_iq_sign(hologram: Hologram, z: float | Sequence[float] | np.ndarray | 
                     # the aliasing of the pitch and the like: the user's own imaging says so
                     warnings.simplefilter("ignore")
                     img = migrate(conjugate(h) if flip else h, zs, upsample=1, pad=PAD,
-                                  progress=False, dtype=np.complex128, **opts)
+                                  progress=False, dtype=np.complex64, **opts)
                 total = total + np.abs(img.data) ** 2
             sides.append(_sharpness(np.sqrt(total)))
     except ValueError as exc:  # a grid or geometry the imaging refuses: no verdict

@@ -26,7 +26,8 @@ from ..data.hologram import Hologram, Image
 from ..data.plausibility import check_plausible
 from .gpr import GPR_SUFFIXES, read_gpr
 from .layout import LENGTH_UNITS, Layout, assemble
-from .netcdf import from_dataset, read_direct, read_history, to_dataset
+from .netcdf import content, from_dataset, read_direct, read_history
+from .netcdf_write import write_content
 from .output import check_output, write_via_temp
 from .readers import read_variables
 
@@ -81,12 +82,8 @@ def save(obj: Hologram | Image, path: str | os.PathLike[str], *, overwrite: bool
                          f"{type(obj).__name__}")
     target = check_output(path, suffixes=NETCDF_SUFFIXES, overwrite=overwrite)
     earlier = LOADED_HISTORY.get(obj, []) if isinstance(obj, Hologram) else []
-    ds = to_dataset(obj, [*earlier, *(history or [])] if earlier else history)
-
-    def write(tmp: Path) -> None:
-        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=False)
-
-    return write_via_temp(target, write)
+    c = content(obj, [*earlier, *(history or [])] if earlier else history)
+    return write_via_temp(target, lambda tmp: write_content(tmp, c))
 
 
 def load(path: str | os.PathLike[str], *, layout: Layout | Mapping[str, Any] | str | None = None,

@@ -9,8 +9,9 @@ from typing import Any
 __all__ = ["history_medium", "medium_of_history", "read_hologram"]
 
 
-def read_hologram(path: Path, layout: Any, check: bool) -> Any:
-    """A hologram from any supported file (:func:`holoradar.load`).
+def read_hologram(path: Path, layout: Any, check: bool, *, iq_check: bool = True) -> Any:
+    """A hologram from any supported file (:func:`holoradar.load`; ``iq_check`` as
+    there).
 
     Raises
     ------
@@ -21,7 +22,7 @@ def read_hologram(path: Path, layout: Any, check: bool) -> Any:
     from ..data.hologram import Hologram
     from . import load
 
-    obj = load(path, layout=layout, check=check)
+    obj = load(path, layout=layout, check=check, iq_check=iq_check)
     if not isinstance(obj, Hologram):
         raise ValueError(f"{path.name} holds an image, not a hologram")
     return obj

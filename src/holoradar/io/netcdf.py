@@ -59,7 +59,8 @@ from ..data.pose import Pose
 from ..physics.dipole import Dipole
 from ..physics.sources import GaussianBeam, PlaneWave, PointSource
 
-__all__ = ["CONVENTIONS", "from_dataset", "read_history", "to_dataset"]
+__all__ = ["CONVENTIONS", "NetcdfContent", "NetcdfVariable", "content", "from_dataset",
+           "read_history", "to_dataset"]
 
 CONVENTIONS = "1"
 _SOURCES = {cls.__name__: cls for cls in (PlaneWave, PointSource, GaussianBeam, Dipole)}
@@ -150,24 +151,45 @@ def _split_iq(data: np.ndarray) -> np.ndarray:
 
 
 def _coord(values: np.ndarray, dim: str, units: str, long_name: str,
-           axis: str | None = None) -> Any:
-    import xarray as xr
-
+           axis: str | None = None) -> NetcdfVariable:
     attrs = {"units": units, "long_name": long_name}
     if axis is not None:
         attrs["axis"] = axis
-    return xr.Variable((dim,), np.asarray(values, float), attrs)
+    return NetcdfVariable((dim,), np.asarray(values, float), attrs)
 
 
-def _frequency(obj: Any) -> Any:
+def _frequency(obj: Any) -> NetcdfVariable:
     """The frequency coordinate: an axis of a band, a scalar coordinate of one."""
-    import xarray as xr
-
     attrs = {"units": "Hz", "long_name": "frequency", "standard_name": "radiation_frequency"}
     f = obj.frequency
     if isinstance(f, np.ndarray):
-        return xr.Variable(("frequency",), np.asarray(f, float), attrs)
-    return xr.Variable((), float(f), attrs)
+        return NetcdfVariable(("frequency",), np.asarray(f, float), attrs)
+    return NetcdfVariable((), np.asarray(float(f)), attrs)
+
+
+@dataclasses.dataclass(frozen=True)
+class NetcdfVariable:
+    """One variable of a file: its dimension names, values and attributes."""
+
+    dims: tuple[str, ...]
+    values: np.ndarray
+    attrs: dict[str, Any]
+
+
+@dataclasses.dataclass(frozen=True)
+class NetcdfContent:
+    """What a holoradar file holds, before any library writes it: the data variable
+    (``name``), the coordinates (dimension coordinates, and scalar ones such as a
+    single frequency) and the global attributes.
+
+    :func:`to_dataset` makes an ``xarray.Dataset`` of it; ``holoradar.save`` writes it
+    through h5netcdf directly (:mod:`holoradar.io.netcdf_write`), without xarray's
+    import (pandas, dask: a second or more in a fresh process)."""
+
+    name: str
+    data: NetcdfVariable
+    coords: dict[str, NetcdfVariable]
+    attrs: dict[str, Any]
 
 
 def _ground_attributes(steps: list[Any]) -> dict[str, Any]:
@@ -206,6 +228,24 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
     """
     import xarray as xr
 
+    c = content(obj, history)
+    coords = {k: xr.Variable(v.dims, v.values, v.attrs) for k, v in c.coords.items()}
+    return xr.Dataset({c.name: xr.Variable(c.data.dims, c.data.values, c.data.attrs)},
+                      coords=coords, attrs=c.attrs)
+
+
+def content(obj: Hologram | Image, history: list[dict[str, Any]] | None = None) -> NetcdfContent:
+    """What the file of ``obj`` holds (see the module text for the layout), the
+    ``save`` step appended to its history.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = Hologram(np.ones((2, 3)), [0.0, 0.01, 0.02], [0.0, 0.01], 9.9e9)
+    >>> c = content(h)
+    >>> c.name, c.data.dims, c.coords["frequency"].dims
+    ('hologram', ('y', 'x', 'iq'), ())
+    """
     now = datetime.now(UTC).isoformat(timespec="seconds")
     # An image's own steps (an inversion's solver, say) come before those given.
     own = list(getattr(obj, "history", ()) or ())
@@ -216,10 +256,10 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
                              "holoradar_version": _version(),
                              "iq_convention": "sample = I + iQ (iq index 0, 1); time "
                                               "dependence exp(-i omega t)"}
-    coords: dict[str, Any] = {
+    coords: dict[str, NetcdfVariable] = {
         # CF has no string coordinates of variable length: the component is a small
         # integer whose meaning flag_values/flag_meanings say.
-        "iq": xr.Variable(("iq",), np.array([0, 1], np.int8), {
+        "iq": NetcdfVariable(("iq",), np.array([0, 1], np.int8), {
             "long_name": "component of the complex sample: in-phase I, quadrature Q",
             "flag_values": np.array([0, 1], np.int8),
             "flag_meanings": "in_phase quadrature", "units": "1"}),
@@ -252,8 +292,8 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
         zattrs = {"units": "m", "long_name": "range of the image planes from the aperture",
                   "axis": "Z", "positive": "down"}
         # A single plane without a plane axis: a scalar coordinate (no unused dimension).
-        coords["z"] = xr.Variable(("z",), z, zattrs) if obj.has_z_axis else \
-            xr.Variable((), float(z.ravel()[0]), zattrs)
+        coords["z"] = NetcdfVariable(("z",), z, zattrs) if obj.has_z_axis else \
+            NetcdfVariable((), np.asarray(float(z.ravel()[0])), zattrs)
         attrs.update(method=str(obj.method), has_z_axis=int(obj.has_z_axis),
                      wideband=int(isinstance(obj.frequency, np.ndarray)))
         long_name = "reconstructed field"
@@ -271,13 +311,13 @@ def to_dataset(obj: Hologram | Image, history: list[dict[str, Any]] | None = Non
         # A real image (an amplitude map): its values as they are, not I and Q = 0 at
         # twice the size read back as complex.
         del coords["iq"], attrs["iq_convention"]
-        values = xr.Variable((*lead, *core), data.astype(
+        values = NetcdfVariable((*lead, *core), data.astype(
             np.float32 if data.dtype == np.float32 else np.float64, copy=False),
             {"long_name": f"{long_name} (real values)", "units": "1"})
     else:
-        values = xr.Variable((*lead, *core, "iq"), _split_iq(data),
-                             {"long_name": long_name, "units": "1"})
-    return xr.Dataset({var: values}, coords=coords, attrs=attrs)
+        values = NetcdfVariable((*lead, *core, "iq"), _split_iq(data),
+                                {"long_name": long_name, "units": "1"})
+    return NetcdfContent(var, values, coords, attrs)
 
 
 def _tx_offset(value: Any, what: str) -> tuple[float, ...] | None:

@@ -76,6 +76,11 @@ def check_image(path: Path, hologram: Any, image: Any, medium: Any, medium_spec:
     iq = warn_if_conjugated(hologram, ahead if ahead.size else None, what=path.name,
                             fix=iq_fix, medium=medium, frame=frame, method=method,
                             stacklevel=2)
+    if iq.sign is None and ahead.size:
+        # Nothing compact at the planes imaged: the ranges where a scene in front of
+        # such an aperture focuses (what reading a user's file checks) may still tell.
+        iq = warn_if_conjugated(hologram, None, what=path.name, fix=iq_fix, medium=medium,
+                                frame=frame, method=method, stacklevel=2)
     out: dict[str, Any] = {"iq_sign": iq.sign, "glare_dominates": None}
     if iq.sign == "I-iQ":  # the glare fit of data in the other convention means nothing
         return out

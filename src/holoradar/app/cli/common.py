@@ -112,6 +112,37 @@ crs_option = click.option(
 """``--crs``: the positions' coordinate reference system, read by pyproj."""
 
 
+def _upsample(ctx: Any, param: Any, value: str) -> int | str:
+    text = str(value).strip().lower()
+    if text == "auto":
+        return "auto"
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if not 1 <= n <= 32:
+        raise click.BadParameter(f"expected 'auto' or a whole number from 1 to 32, got "
+                                 f"{value!r}", param_hint="--upsample")
+    return n
+
+
+upsample_option = click.option(
+    "--upsample", default="auto", show_default=True, metavar="auto|N", callback=_upsample,
+    help="Image pixels per element pitch: a number from 1 to 32, or 'auto': as many as "
+         "give four pixels across the finest lateral resolution cell (lambda L / A, at "
+         "least lambda / 2), 1 where the pitch is that fine already.")
+"""``--upsample``: ``auto`` (sized by the resolution) or a factor."""
+
+
+def resolve_upsample(upsample: int | str, holo: Any, zs: Any, medium: Any) -> int:
+    """The factor ``--upsample`` gives for this hologram and these planes."""
+    if upsample != "auto":
+        return int(upsample)
+    from ...imaging.migration.pixel_size import upsample_for
+
+    return upsample_for(holo, zs, medium)
+
+
 def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
     """``--layout`` and ``--no-check`` for reading users' files."""
 
@@ -153,12 +184,13 @@ def layout_option(fn: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
-def read_hologram(path: Path, layout: str | None, check: bool) -> Any:
+def read_hologram(path: Path, layout: str | None, check: bool, *, iq_check: bool = True) -> Any:
     """A hologram from any supported file; an image file is refused by name
-    (:func:`holoradar.io.inputs.read_hologram`)."""
+    (:func:`holoradar.io.inputs.read_hologram`). ``iq_check=False``: the caller checks
+    the I/Q sign itself, at the ranges it images."""
     from ...io.inputs import read_hologram as read
 
-    return read(path, layout, check)
+    return read(path, layout, check, iq_check=iq_check)
 
 
 def input_history(path: Path, layout: str | None) -> list[dict[str, Any]]:

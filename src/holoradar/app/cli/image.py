@@ -23,6 +23,8 @@ from .common import (
     medium_options,
     output_options,
     read_hologram,
+    resolve_upsample,
+    upsample_option,
 )
 
 __all__ = ["COMMANDS", "write_image"]
@@ -70,8 +72,7 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
 @click.option("--method", type=click.Choice(["angular", "fresnel"]), default="angular",
               show_default=True, help="Exact angular spectrum, or the paper's Fresnel kernel.")
 @frame_option
-@click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32),
-              help="Image pixels per element pitch.")
+@upsample_option
 @click.option("--double", is_flag=True,
               help="Compute in double precision (default single: within 1e-6 of the image's "
                    "peak, about twice as fast).")
@@ -83,7 +84,7 @@ def write_image(img: Any, out: Path, force: bool, history: list[dict[str, Any]],
 @layout_option
 @output_options
 def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str, frame: str,
-          upsample: int, double: bool, out: Path, png: bool, force: bool, layout: str | None,
+          upsample: int | str, double: bool, out: Path, png: bool, force: bool, layout: str | None,
           check: bool, report: Reporter) -> None:
     """Migrate a hologram to range(s) Z through air or a (layered, lossy) ground.
 
@@ -106,9 +107,11 @@ def image(hologram_file: Path, z: str, medium_spec: dict[str, Any], method: str,
     # report of the image lists it).
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
-        holo = read_hologram(hologram_file, layout, check)
+        # The I/Q sign is checked after imaging, at the planes imaged (check_image).
+        holo = read_hologram(hologram_file, layout, check, iq_check=False)
         medium = medium_from_options(medium_spec, float(np.mean(holo.frequencies)))
         check_planes(holo, zs, z, medium, medium_spec, check)
+        upsample = resolve_upsample(upsample, holo, zs, medium)
         _check_room(holo, zs, upsample, double, out, report)
         t0 = time.perf_counter()
         img = migrate(holo, zs, medium=medium, method=method, upsample=upsample, frame=frame,

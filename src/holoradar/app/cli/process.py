@@ -24,7 +24,9 @@ from .common import (
     medium_options,
     output_options,
     read_hologram,
+    resolve_upsample,
     triple,
+    upsample_option,
 )
 from .image import write_image
 
@@ -157,7 +159,7 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
               help="How the views add: complex sum with each view's incident phase removed, "
                    "phase-aligned sum, or sum of amplitudes.")
 @frame_option
-@click.option("--upsample", default=4, show_default=True, type=click.IntRange(1, 32))
+@upsample_option
 @click.option("--horn", "horns", multiple=True, help=_SOURCE_HELP)
 @click.option("--plane-wave", "plane_waves", multiple=True, metavar="ALPHA,BETA",
               help="A plane-wave view's angles from z towards x and y, degrees (repeat once "
@@ -172,7 +174,7 @@ def suppress(hologram_file: Path, medium_spec: dict[str, Any], method: str,
 @layout_option
 @output_options
 def synthesize(hologram_files: tuple[Path, ...], z: str, medium_spec: dict[str, Any],
-               mode: str, frame: str, upsample: int, horns: tuple[str, ...],
+               mode: str, frame: str, upsample: int | str, horns: tuple[str, ...],
                plane_waves: tuple[str, ...], pattern: float, out: Path, png: bool, force: bool,
                layout: str | None, check: bool, report: Reporter) -> None:
     """Image several views of one scene (different illuminations) into one image.
@@ -201,6 +203,7 @@ def synthesize(hologram_files: tuple[Path, ...], z: str, medium_spec: dict[str, 
                                  param_hint="--horn/--plane-wave")
     medium = medium_from_options(medium_spec, float(np.mean(views[0].frequencies)))
     check_planes(views[0], zs, z, medium, medium_spec, check)
+    upsample = resolve_upsample(upsample, views[0], zs, medium)
     t0 = time.perf_counter()
     img = run(views, zs, medium=medium, mode=mode, upsample=upsample, frame=frame)
     seconds = time.perf_counter() - t0

@@ -29,6 +29,7 @@ loads it ahead of the first call.
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -46,7 +47,7 @@ from .terms import TermsKey
 
 sfft = lazy_module("scipy.fft")  # imported on first use: see holoradar._lazy
 
-__all__ = ["TINY", "adjoint_columns", "available", "warm"]
+__all__ = ["TINY", "adjoint_columns", "available", "loaded", "warm"]
 
 _COLS = 256          # components per block of the compiled loop (its terms stay in cache)
 _THREADED_TERMS = 1 << 22  # multiply-adds in one call worth sharing among threads
@@ -84,9 +85,24 @@ def available() -> bool:
     return True
 
 
-@cache
+_KERNEL_LOCK = threading.Lock()
+
+
+def loaded() -> bool:
+    """Whether this process has loaded the compiled loop (numba imported, the loop
+    built or read from its cache): a next call pays nothing for it."""
+    return _build_kernel.cache_info().currsize > 0
+
+
 def _kernel() -> Any:
-    """The compiled column sum (numba, cached on disk; built on first use)."""
+    """The compiled column sum (numba, cached on disk; built on first use), built once
+    even when a background :func:`warm` and the first migration ask at once."""
+    with _KERNEL_LOCK:
+        return _build_kernel()
+
+
+@cache
+def _build_kernel() -> Any:
     import numba
 
     def column_sum(ar, ai, sr, si, jm, bend, pos, order, n, j0, j1, zero, outv):
@@ -173,9 +189,11 @@ def _kernel() -> Any:
         return numba.njit(cache=False, **options)(column_sum)
 
 
-def warm() -> None:
+def warm(precisions: tuple[type, ...] = (np.float32, np.float64)) -> None:
     """Import numba and load (or, the first time, compile and cache) the compiled loop in
-    both precisions, so that the next wideband ``migrate`` does not pay for it.
+    both precisions (or those of ``precisions``: ``np.float32`` for complex64 work,
+    ``np.float64`` for complex128), so that the next wideband ``migrate`` does not pay
+    for it.
 
     For a long-lived process (a viewer, a server) to call at start-up, e.g. in a
     background thread; and once after installing, to build the on-disk cache (the
@@ -187,7 +205,7 @@ def warm() -> None:
         a.setflags(write=False)   # as a ColumnPlan's arrays are: numba types them apart
         return a
 
-    for real in (np.float32, np.float64):
+    for real in precisions:
         z = np.zeros((1, 1, _COLS), dtype=real)
         kernel(z, z.copy(), frozen(z.copy()), frozen(z.copy()),
                frozen(np.zeros((1, 1, _COLS), np.int32)), frozen(np.zeros(1, np.int32)),
