@@ -50,7 +50,7 @@ def test_the_command_line_takes_both_files(tmp_path):
     out = tmp_path / "img.nc"
     run("image", tmp_path / "scan.npz", "--z", "0.17", "--layout",
         "axes=fyx,monostatic=true,iq_sign=I+iQ", "--frequency-file", freqs, "--response",
-        table, "-o", out, "--no-png", "-q")
+        table, "--upsample", "4", "-o", out, "--no-png", "-q")
     img = hr.load(out)
     ref = hr.migrate(h, 0.17, upsample=4)
     peak = np.unravel_index(np.argmax(np.abs(img.data)), img.data.shape)
