@@ -64,7 +64,11 @@ def invert(hologram: Hologram, z: Any, *, medium: Any = None, method: str = "lsq
         ``frame``, ``x``, ``y``, ``dtype``, ``pad``, ``algorithm``... Defaults here: each
         voxel a point scatterer (``scatterer="point"``), lit by the source's field
         (``illumination="field"``), no loss compensation, unit frequency weights, the
-        smooth band limit on a grid padded at least 3x.
+        smooth band limit on a grid padded at least 3x, and single precision
+        (``dtype=np.complex64``, as ``migrate``: the solver's steps about twice as
+        fast; the paper's 16 x 16 onto 61 x 61 x 40 voxels takes the same 54 steps
+        and its peak agrees with double precision to 1.3e-6; ``dtype=np.complex128``
+        for double).
 
     Returns
     -------
@@ -175,6 +179,7 @@ def _check(hologram: Any, method: Any, max_iter: Any, need_source: bool = True) 
 def _options(hologram: Hologram, z: Any, given: dict[str, Any]) -> dict[str, Any]:
     """The operator's options: the physics, and a grid padded for an accurate model."""
     opts = {**preset_options("inversion"), **given}
+    opts.setdefault("dtype", np.complex64)
     if given.get("frame", "aperture") == "aperture":
         opts.setdefault("band_limit", "smooth")
         if "pad" not in given:
