@@ -174,3 +174,15 @@ def test_a_volume_that_does_not_fit_is_refused_before_any_work(monkeypatch):
     monkeypatch.setattr(memory, "available_memory", lambda: 10**9)
     migrate64(h, ZS)
     assert work and work[-1] == 1
+
+
+def test_an_operator_takes_the_compiled_sum_even_before_it_is_loaded(monkeypatch):
+    # An operator is applied many times (a solver's steps): the load pays for itself.
+    from holoradar.imaging.migration import choose
+
+    monkeypatch.setattr(columns, "loaded", lambda: False)
+    monkeypatch.setattr(choose, "_NUMPY_WORK", [0.0])
+    h = _hologram(True, None, False, np.complex128)
+    A = hr.migration_operator(h, ZS)
+    assert A.backend.name == "columns"
+    assert choose._NUMPY_WORK[0] == 0.0

@@ -45,8 +45,10 @@ BACKENDS: dict[str, Backend] = {b.name: b for b in (
     GroundNufft(), Offset())}
 
 
-def choose(plan: MigrationPlan) -> Backend:
-    """The backend that computes ``plan`` (see the module docstring).
+def choose(plan: MigrationPlan, *, repeated: bool = False) -> Backend:
+    """The backend that computes ``plan`` (see the module docstring). ``repeated``: the
+    plan is an operator's, to be applied many times (a solver's steps): a band takes
+    the compiled sum whether or not it is loaded yet.
 
     Raises
     ------
@@ -66,7 +68,7 @@ def choose(plan: MigrationPlan) -> Backend:
                              f"which needs {why}")
         return offset
     if name == "auto":
-        candidates = _preferences(plan)
+        candidates = _preferences(plan, repeated)
     elif name == "frequency":
         # Plane by plane, whatever the frame or kernel: no phase-step shortcut.
         candidates = [BACKENDS["fresnel"], *_ground(plan), BACKENDS["frequency"]]
@@ -83,14 +85,15 @@ def choose(plan: MigrationPlan) -> Backend:
     raise ValueError(f"no migration backend applies to these settings ({reasons})")
 
 
-def _preferences(plan: MigrationPlan) -> list[Backend]:
+def _preferences(plan: MigrationPlan, repeated: bool = False) -> list[Backend]:
     if plan.settings.frame == "ground":
         return _ground(plan)
     if plan.settings.method == "fresnel":
         return [BACKENDS["fresnel"]]
     if plan.wideband:
         sums = [BACKENDS["columns"], BACKENDS["kspace"]]
-        return [*(sums if compiled_pays(plan) else sums[::-1]), BACKENDS["frequency"]]
+        fast = repeated or compiled_pays(plan)
+        return [*(sums if fast else sums[::-1]), BACKENDS["frequency"]]
     # (one plane: nothing to step to)
     step = [BACKENDS["kspace"]] if plan.z.size > 1 and _too_big_to_cache(plan) else []
     return [*step, BACKENDS["frequency"]]

@@ -126,7 +126,8 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
     else:
         plan = make_plan(hologram, z, medium, s)
     plan.snr_db  # noqa: B018  (estimated now, from the data given: the map is then fixed)
-    return MigrationOperator(plan, choose(plan), sampled=(u, without_data(hologram)))
+    return MigrationOperator(plan, choose(plan, repeated=True),
+                             sampled=(u, without_data(hologram)))
 
 
 class MigrationOperator(LinearOperator):
