@@ -188,6 +188,27 @@ class Hologram(Band):
         return (f"<holoradar.Hologram {self.data.shape} {self.data.dtype}: "
                 f"{_band_text(self.frequencies)}; {_grid_text(self.x, self.y)}; {kind}{src}>")
 
+    @staticmethod
+    def from_samples(data: Any, positions: Any, frequency: Any, *, tx: Any = None,
+                     monostatic: bool = False, source: Any = None,
+                     polarization: Any = None) -> Any:
+        """A hologram of samples at scattered positions (a freehand or uneven scan):
+        :func:`holoradar.data.samples.from_samples`, which documents the arguments.
+        ``migrate`` and ``migration_operator`` image it onto a grid (``x=``, ``y=``).
+
+        Examples
+        --------
+        >>> rng = np.random.default_rng(0)
+        >>> s = Hologram.from_samples(np.ones(200), rng.uniform(0, 0.1, (200, 2)), 10e9,
+        ...                           monostatic=True)
+        >>> s.n, s.monostatic
+        (200, True)
+        """
+        from .samples import from_samples
+
+        return from_samples(data, positions, frequency, tx=tx, monostatic=monostatic,
+                            source=source, polarization=polarization)
+
     @classmethod
     def from_traces(cls, traces: Any, dt: float, x: Any, *,
                     band: tuple[float, float] | None = None, time_zero: float = 0.0,

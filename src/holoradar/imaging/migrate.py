@@ -21,6 +21,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..data.hologram import Hologram, Image
+from ..data.samples import SampledHologram
 from ..physics.medium import Medium
 from .migration.image import image_of
 from .migration.memory import check_fits
@@ -44,12 +45,16 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
 
     Parameters
     ----------
-    hologram : Hologram
+    hologram : Hologram or SampledHologram
         Field on a uniform grid of the aperture plane, shape (..., ny, nx), or
         (..., nf, ny, nx) with nf frequencies. A monostatic hologram (scanned
         transceiver) is back-propagated over the round trip (wavenumber 2k; in a
         medium each layer's round-trip kz and both legs' transmissions,
-        :func:`~holoradar.physics.propagation.two_way_transfer`).
+        :func:`~holoradar.physics.propagation.two_way_transfer`). Samples at
+        scattered positions (:meth:`Hologram.from_samples`) are imaged onto the grid
+        ``x``, ``y`` (default: their extent at the image band's Nyquist pitch) through
+        non-uniform FFTs (:mod:`holoradar.imaging.samples`); ``pad``, ``upsample``,
+        ``fov`` and ``frame`` then keep their defaults.
     z : float or sequence of float
         Image ranges from the aperture, metres (>= 0). A scalar gives one plane.
     medium : Medium, optional
@@ -182,6 +187,16 @@ def migrate(hologram: Hologram, z: float | Sequence[float] | np.ndarray, *,
     """
     if dtype is None:
         dtype = np.complex64   # the default users run: single precision (see dtype)
+    if isinstance(hologram, SampledHologram):   # scattered samples: imaging/samples.py
+        from .samples import migrate_samples
+
+        given = {k: v for k, v, default in (("pad", pad, True), ("upsample", upsample, 1),
+                                             ("fov", fov, "aperture"),
+                                             ("frame", frame, "aperture")) if v != default}
+        return migrate_samples(hologram, z, x=x, y=y, equalize=equalize, medium=medium,
+                               method=method, compensate_loss=compensate_loss,
+                               snr_db=snr_db, dtype=dtype, progress=progress,
+                               combine=combine, algorithm=algorithm, **given)
     options = (method, pad, upsample, compensate_loss, snr_db, fov, dtype, progress, combine,
                equalize, algorithm, frame)
     if x is None and y is None and _hashable(options):

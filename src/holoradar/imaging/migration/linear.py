@@ -24,6 +24,7 @@ import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
 from ...data.hologram import Hologram, Image
+from ...data.samples import SampledHologram
 from .backends.base import Backend
 from .choose import choose
 from .plan import MigrationPlan, make_plan, without_data
@@ -103,6 +104,14 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
     >>> bool(np.isclose(np.vdot(A @ r, d), np.vdot(r, A.H @ d), rtol=1e-12))
     True
     """
+    if isinstance(hologram, SampledHologram):   # scattered samples: imaging/samples.py
+        from ..samples import samples_operator
+
+        if settings is not None or sampling != "auto":
+            raise ValueError("scattered samples take options by name (no settings=, "
+                             "sampling=)")
+        return samples_operator(hologram, z, medium=medium,
+                                **{**preset_options(preset), **options})
     given = dict(options)
     if settings is None:
         given = {**preset_options(preset), **given}
