@@ -145,3 +145,28 @@ def test_grid_only_options_are_refused():
         hr.migrate(s, 0.1, upsample=2)
     with pytest.raises(ValueError, match="x must be uniform"):
         hr.migrate(s, 0.1, x=[0.0, 0.01, 0.03])
+
+
+def test_coverage_finds_the_hole_and_a_nyquist_grid_covers_everything():
+    from holoradar.imaging.samples import coverage
+
+    # A grid at exactly the band's Nyquist spacing (lambda_min / 4, a transceiver):
+    # every pixel is within spacing / sqrt(2) of a sample.
+    s = C0 / F.max() / 4
+    g = np.arange(0, 0.08, s)
+    X, Y = np.meshgrid(g, g)
+    grid = hr.Hologram.from_samples(np.ones((F.size, X.size)),
+                                    np.column_stack([X.ravel(), Y.ravel()]), F,
+                                    monostatic=True)
+    c = coverage(grid, x=np.linspace(0, g[-1], 41), y=np.linspace(0, g[-1], 41))
+    assert c.fraction == 1.0
+    # the freehand scan's 2 cm hole at (2, -1) cm is uncovered, its sweeps are not
+    p = _freehand(0)
+    c = coverage(hr.Hologram.from_samples(np.ones((F.size, len(p))), p, F, monostatic=True),
+                 x=np.linspace(-0.04, 0.04, 33), y=np.linspace(-0.04, 0.04, 33))
+    ix, iy = np.argmin(np.abs(c.x - 0.02)), np.argmin(np.abs(c.y + 0.01))
+    assert not c.covered[iy, ix]
+    # Sweeps 1.1 cm apart, 3 mm steps along them: a pixel is covered within
+    # sqrt((6.25 / sqrt 2)^2 - 1.5^2) = 4.2 mm of a sweep, 8.3 mm of each 11.1 mm (0.75);
+    # the hole takes pi 2^2 / 8^2 = 20 % of the patch: about 0.75 x 0.8 = 0.6
+    assert 0.5 < c.fraction < 0.75

@@ -41,7 +41,8 @@ from ..data.samples import SampledHologram
 
 sfft = lazy_module("scipy.fft")
 
-__all__ = ["SamplesBox", "image_axes", "migrate_samples", "samples_operator"]
+__all__ = ["Coverage", "SamplesBox", "coverage", "image_axes", "migrate_samples",
+           "samples_operator"]
 
 #: Precision asked of the non-uniform FFTs (relative, finufft's ``eps``).
 NUFFT_EPS = 1e-9
@@ -278,3 +279,53 @@ def samples_operator(samples: SampledHologram, z: Any, *, x: Any = None, y: Any 
     G = migration_operator(proxy, z, pad=False, fov="aperture",
                            equalize=_weights(samples, equalize), **options)
     return SamplesOperator(samples, G, box, xs, ys)
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Where samples are dense enough for the image's band: ``distance`` (ny, nx), metres,
+    from each pixel of ``x``, ``y`` to its nearest sample; ``spacing`` the band's Nyquist
+    spacing (``lambda_min / 4`` for a transceiver, ``lambda_min / 2`` otherwise);
+    ``covered`` where ``distance <= spacing / sqrt(2)`` (a grid at that spacing covers
+    every pixel: its farthest point, a cell's centre, is that far)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    distance: np.ndarray
+    spacing: float
+
+    @property
+    def covered(self) -> np.ndarray:
+        return self.distance <= self.spacing / math.sqrt(2) * (1 + 1e-9)
+
+    @property
+    def fraction(self) -> float:
+        """The share of the pixels covered."""
+        return float(np.mean(self.covered))
+
+
+def coverage(samples: SampledHologram, x: Any = None, y: Any = None) -> Coverage:
+    """The samples' coverage of the image grid (default :func:`image_axes`): the holes
+    a freehand scan left, where the image holds only what reaches them from afar.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import holoradar as hr
+    >>> g = np.arange(0, 0.1, 0.006)
+    >>> X, Y = np.meshgrid(g, g)
+    >>> p = np.column_stack([X.ravel(), Y.ravel()])
+    >>> p = p[np.hypot(p[:, 0] - 0.05, p[:, 1] - 0.05) > 0.02]     # a hole of 2 cm
+    >>> s = hr.Hologram.from_samples(np.ones(len(p)), p, 12e9, monostatic=True)
+    >>> c = coverage(s)
+    >>> round(c.spacing * 1000, 2), c.covered[c.y.size // 2, c.x.size // 2]
+    (6.25, np.False_)
+    """
+    from scipy.spatial import cKDTree
+
+    xs, ys = image_axes(samples, x, y)
+    lam = C0 / float(samples.frequencies.max())
+    spacing = lam / 4 if samples.monostatic else lam / 2
+    X, Y = np.meshgrid(xs, ys)
+    dist, _ = cKDTree(samples.positions[:, :2]).query(np.column_stack([X.ravel(), Y.ravel()]))
+    return Coverage(xs, ys, dist.reshape(X.shape), spacing)
