@@ -22,14 +22,13 @@ from __future__ import annotations
 
 import json
 import os
-import statistics
 import subprocess
 import sys
-import time
 import warnings
 from pathlib import Path
 
 import numpy as np
+from timing import median
 
 HERE = Path(__file__).parent
 REPEAT = 5
@@ -48,13 +47,7 @@ def case() -> tuple:
 
 
 def _median(fn, repeat: int = REPEAT) -> float:
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+    return median(fn, repeat)
 
 
 def das_frequency(d: np.ndarray, x: np.ndarray, f: np.ndarray, zs: np.ndarray,

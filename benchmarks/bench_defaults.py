@@ -69,12 +69,9 @@ def hologram(dtype=np.complex128):
 
 
 def best(fn, n: int = 3) -> float:
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
+    from timing import best as fastest
+
+    return fastest(fn, n, warm=False)   # main() warms every run first
 
 
 def cold_child() -> None:

@@ -11,10 +11,10 @@ Run: .venv/bin/python benchmarks/bench_parabolic.py
 from __future__ import annotations
 
 import platform
-import time
 
 import numpy as np
 import scipy.fft as sfft
+from timing import best as fastest
 
 import holoradar as hr
 from holoradar.physics.parabolic import ParabolicEquation
@@ -24,12 +24,7 @@ N, STEPS = 256, 200
 
 
 def best(fn) -> float:
-    out = []
-    for _ in range(REPEAT):
-        t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return min(out)
+    return fastest(fn, REPEAT, warm=False)
 
 
 def main() -> None:

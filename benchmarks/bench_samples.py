@@ -24,6 +24,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from timing import best
 
 import holoradar as hr
 
@@ -52,16 +53,6 @@ def point_data(x: np.ndarray, y: np.ndarray) -> np.ndarray:
         R = np.sqrt((x - px) ** 2 + (y - py) ** 2 + pz**2)
         d = d + np.exp(2j * k * R) / R**2
     return d
-
-
-def best(fn, n: int = 3) -> float:
-    fn()
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def matched_filter_part(p: np.ndarray, d: np.ndarray) -> float:

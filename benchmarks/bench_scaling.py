@@ -34,6 +34,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from timing import best
 
 HERE = Path(__file__).parent
 BASE = {"n": 64, "planes": 32, "nf": 8}
@@ -59,16 +60,6 @@ def hologram(n: int, nf: int):
 
 def planes(count: int) -> np.ndarray:
     return np.array([0.08]) if count == 1 else np.linspace(0.02, 0.18, count)
-
-
-def best(fn, n: int = 3) -> float:
-    fn()
-    out = []
-    for _ in range(n):
-        t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return min(out)
 
 
 def floor(n: int, nf: int, nz: int) -> float:
