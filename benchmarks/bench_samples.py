@@ -12,6 +12,11 @@ chunks of pixels) would take hours: it is timed on one plane and two frequencies
 samples, all pixels) and scaled by planes x frequencies / 2 (its cost is exactly
 proportional to each).
 
+Streaming (``SampleStream``): the same samples added in batches of 100 (as a tracker
+delivers them) onto the same grid, the image redrawn after every 10 batches (1000
+samples); the samples per second of the whole (adds and redraws), and the seconds of
+one redraw.
+
 Run: ``.venv/bin/python benchmarks/bench_samples.py``; writes
 ``benchmarks/results_samples.json``.
 """
@@ -83,12 +88,23 @@ def main() -> None:
     t_samples = best(lambda: hr.migrate(s, ZS, x=XS, y=XS))
     t_grid = best(lambda: hr.migrate(h, ZS))
     t_mf = matched_filter_part(p, d) * ZS.size * F.size / 2
+    from holoradar.imaging.samples_stream import SampleStream
+
+    stream = SampleStream(F, ZS, XS, XS, monostatic=True)
+    t = time.perf_counter()
+    for i in range(0, len(p), 100):
+        stream.add(d[:, i:i + 100], p[i:i + 100])
+        if (i // 100) % 10 == 9:
+            stream.image()
+    t_add = time.perf_counter() - t
+    t_image = best(stream.image)
     out = {"samples": len(p), "frequencies": int(F.size),
            "voxels": [int(ZS.size), int(XS.size), int(XS.size)],
            "migrate_samples_s": t_samples, "migrate_grid_s": t_grid,
            "matched_filter_s_estimated": t_mf,
            "matched_filter_over_samples": t_mf / t_samples,
-           "samples_over_grid": t_samples / t_grid}
+           "samples_over_grid": t_samples / t_grid,
+           "stream_samples_per_s": len(p) / t_add, "stream_image_s": t_image}
     (HERE / "results_samples.json").write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))
 

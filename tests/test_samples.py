@@ -170,3 +170,24 @@ def test_coverage_finds_the_hole_and_a_nyquist_grid_covers_everything():
     # sqrt((6.25 / sqrt 2)^2 - 1.5^2) = 4.2 mm of a sweep, 8.3 mm of each 11.1 mm (0.75);
     # the hole takes pi 2^2 / 8^2 = 20 % of the patch: about 0.75 x 0.8 = 0.6
     assert 0.5 < c.fraction < 0.75
+
+
+def test_a_stream_of_batches_is_the_image_of_all_its_samples():
+    from holoradar.imaging.samples_stream import SampleStream
+
+    p = _freehand(0)
+    d = _point_data(p, F)
+    xs = ys = np.linspace(-0.06, 0.06, 25)
+    zs = [0.09, 0.1, 0.12]
+    stream = SampleStream(F, zs, xs, ys, monostatic=True, dtype=np.complex128)
+    for i in range(0, len(p), 97):    # batches as a tracker delivers them
+        stream.add(d[:, i:i + 97], p[i:i + 97])
+    s = hr.Hologram.from_samples(d, p, F, monostatic=True)
+    ref = hr.migrate(s, zs, x=xs, y=ys, dtype=np.complex128)
+    # the same box (the samples lie inside the grid's extent) and the same sum, taken in
+    # batches: the transforms' rounding (finufft eps 1e-9)
+    assert stream.n == len(p)
+    err = np.max(np.abs(stream.image().data - ref.data)) / np.max(np.abs(ref.data))
+    assert err < 1e-7, err
+    with pytest.raises(ValueError, match="outside the image's box"):
+        stream.add(np.ones((F.size, 2)), [[5.0, 0.0], [5.01, 0.0]])

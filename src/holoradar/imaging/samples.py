@@ -91,18 +91,33 @@ class SamplesBox:
     @classmethod
     def of(cls, samples: SampledHologram, x: np.ndarray, y: np.ndarray) -> SamplesBox:
         """The box for these samples and this image grid: the extent of both, twice."""
+        p = samples.positions
+        return cls.spanning(x, y, (float(p[:, 0].min()), float(p[:, 1].min())),
+                            (float(p[:, 0].max()), float(p[:, 1].max())))
+
+    @classmethod
+    def spanning(cls, x: np.ndarray, y: np.ndarray, lo: tuple[float, float] | None = None,
+                 hi: tuple[float, float] | None = None) -> SamplesBox:
+        """The box of the image grid ``x``, ``y`` and the extent ``lo`` .. ``hi`` (x, y,
+        metres; default the grid's own): twice their joint extent."""
         vals = []
-        for c, col in ((x, 0), (y, 1)):
+        for i, c in enumerate((x, y)):
             d = float(c[1] - c[0])
-            p = samples.positions[:, col]
-            lo, hi = min(float(c[0]), float(p.min())), max(float(c[-1]), float(p.max()))
-            below = math.ceil((float(c[0]) - lo) / d - 1e-9)   # box points before x[0]
-            span = math.ceil((hi - lo) / d - 1e-9) + 2
+            a = float(c[0]) if lo is None else min(float(c[0]), lo[i])
+            b = float(c[-1]) if hi is None else max(float(c[-1]), hi[i])
+            below = math.ceil((float(c[0]) - a) / d - 1e-9)   # box points before c[0]
+            span = math.ceil((b - a) / d - 1e-9) + 2
             m = int(sfft.next_fast_len(2 * span))
             start = below + (m - span) // 2    # the image grid's first index in the box
             vals.append((float(c[0]) - start * d, d, m, start, c.size))
         (x0, dx, mx, ix, nx), (y0, dy, my, iy, ny) = vals
         return cls(x0, y0, dx, dy, mx, my, ix, iy, nx, ny)
+
+    def holds(self, positions: np.ndarray) -> np.ndarray:
+        """Which positions ``(n, >=2)`` lie inside the box (else they would fold)."""
+        u = (positions[:, 0] - self.x0) / (self.mx * self.dx)
+        v = (positions[:, 1] - self.y0) / (self.my * self.dy)
+        return (u >= 0) & (u < 1) & (v >= 0) & (v < 1)
 
     @property
     def x(self) -> np.ndarray:
@@ -112,20 +127,27 @@ class SamplesBox:
     def y(self) -> np.ndarray:
         return self.y0 + np.arange(self.my) * self.dy
 
-    def phases(self, samples: SampledHologram) -> tuple[np.ndarray, np.ndarray]:
-        """The positions as finufft's angles, ``2 pi (r - r0) / L`` in ``[-pi, pi)``."""
-        ax = 2 * np.pi * (samples.positions[:, 0] - self.x0) / (self.mx * self.dx)
-        ay = 2 * np.pi * (samples.positions[:, 1] - self.y0) / (self.my * self.dy)
+    def phases(self, samples: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The positions (of a SampledHologram, or an ``(n, >=2)`` array) as finufft's
+        angles, ``2 pi (r - r0) / L`` in ``[-pi, pi)``."""
+        p = samples.positions if isinstance(samples, SampledHologram) else samples
+        ax = 2 * np.pi * (p[:, 0] - self.x0) / (self.mx * self.dx)
+        ay = 2 * np.pi * (p[:, 1] - self.y0) / (self.my * self.dy)
         return (np.mod(ay + np.pi, 2 * np.pi) - np.pi, np.mod(ax + np.pi, 2 * np.pi) - np.pi)
 
-    def to_box(self, samples: SampledHologram, data: np.ndarray) -> np.ndarray:
-        """``P^H``: samples ``(nf, n)`` to the box's field ``(nf, my, mx)``."""
+    def spectrum(self, samples: Any, data: np.ndarray) -> np.ndarray:
+        """``D(k) = sum_n d_n exp(-i k.(r_n - r_0))`` of samples ``(nf, n)`` (positions
+        as :meth:`phases` takes them) on the box's wavenumbers, ``(nf, my, mx)``."""
         import finufft
 
         ay, ax = self.phases(samples)
         D = finufft.nufft2d1(ay, ax, np.ascontiguousarray(data, dtype=complex),
                              (self.my, self.mx), eps=NUFFT_EPS, isign=-1, modeord=1)
-        return sfft.ifft2(D.reshape(-1, self.my, self.mx), workers=-1)
+        return D.reshape(-1, self.my, self.mx)
+
+    def to_box(self, samples: Any, data: np.ndarray) -> np.ndarray:
+        """``P^H``: samples ``(nf, n)`` to the box's field ``(nf, my, mx)``."""
+        return sfft.ifft2(self.spectrum(samples, data), workers=-1)
 
     def from_box(self, samples: SampledHologram, field: np.ndarray) -> np.ndarray:
         """``P``: the box's field ``(nf, my, mx)`` read at the positions, ``(nf, n)``."""
