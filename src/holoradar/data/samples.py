@@ -125,6 +125,37 @@ def from_samples(data: Any, positions: Any, frequency: Any, *, tx: Any = None,
     if source is not None and not (hasattr(source, "field") and hasattr(source, "reflected")):
         raise ValueError(f"source must be a PlaneWave, PointSource, GaussianBeam or None, got "
                          f"{type(source).__name__}")
+    pos = _positions(positions)
+    f = np.atleast_1d(np.asarray(frequency, dtype=float))
+    if f.ndim != 1 or not np.all(np.isfinite(f)) or np.any(f <= 0) or \
+            (f.size > 1 and np.any(np.diff(f) <= 0)):
+        raise ValueError(f"frequency must be positive and increasing, Hz, got {frequency!r}")
+    try:
+        arr = np.array(data, dtype=complex)
+    except (TypeError, ValueError):
+        raise ValueError("data must be complex numbers, shape (nf, n) or (n,)") from None
+    arr = arr.reshape(1, -1) if arr.ndim == 1 else arr
+    if arr.ndim != 2 or arr.shape != (f.size, len(pos)):
+        raise ValueError(f"data must have shape (nf, n) = ({f.size}, {len(pos)}) (frequency "
+                         f"first, one sample per position), got {np.shape(data)}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"data: {int(np.sum(~np.isfinite(arr)))} samples are NaN or infinite")
+    lam = C0 / float(f.max())
+    span = float(np.max(np.ptp(pos[:, :2], axis=0)))
+    if span < lam / 100 or span > 1000 * lam:
+        raise ValueError(f"positions span {span:g} m, against a wavelength of {lam:.3g} m: "
+                         "metres are expected (millimetres given as metres?)")
+    pos.setflags(write=False)
+    arr.setflags(write=False)
+    freq: Any = f if f.size > 1 else float(f[0])
+    out = arr if f.size > 1 else arr[0]
+    return SampledHologram(out, pos, freq, source, bool(monostatic),
+                           as_polarization(polarization, "polarization"))
+
+
+def _positions(positions: Any) -> np.ndarray:
+    """The positions as an ``(n, 3)`` array, checked: shape, finite, on the aperture
+    plane (z = 0), none repeated."""
     try:
         pos = np.array(positions, dtype=float)
     except (TypeError, ValueError):
@@ -143,34 +174,10 @@ def from_samples(data: Any, positions: Any, frequency: Any, *, tx: Any = None,
         raise ValueError("positions: z must be 0 (the samples lie on the aperture plane, from "
                          "which ranges are counted); give (n, 2) positions or move the "
                          "ranges by the height")
-    f = np.atleast_1d(np.asarray(frequency, dtype=float))
-    if f.ndim != 1 or not np.all(np.isfinite(f)) or np.any(f <= 0) or \
-            (f.size > 1 and np.any(np.diff(f) <= 0)):
-        raise ValueError(f"frequency must be positive and increasing, Hz, got {frequency!r}")
-    try:
-        arr = np.array(data, dtype=complex)
-    except (TypeError, ValueError):
-        raise ValueError("data must be complex numbers, shape (nf, n) or (n,)") from None
-    arr = arr.reshape(1, -1) if arr.ndim == 1 else arr
-    if arr.ndim != 2 or arr.shape != (f.size, len(pos)):
-        raise ValueError(f"data must have shape (nf, n) = ({f.size}, {len(pos)}) (frequency "
-                         f"first, one sample per position), got {np.shape(data)}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"data: {int(np.sum(~np.isfinite(arr)))} samples are NaN or infinite")
     _, first, counts = np.unique(pos[:, :2], axis=0, return_index=True, return_counts=True)
     if np.any(counts > 1):
         extra = int(np.sum(counts - 1))
         raise ValueError(f"positions: {extra} repeat an earlier position (e.g. index "
                          f"{int(first[np.argmax(counts > 1)])}); average the repeats or drop "
                          "them")
-    lam = C0 / float(f.max())
-    span = float(np.max(np.ptp(pos[:, :2], axis=0)))
-    if span < lam / 100 or span > 1000 * lam:
-        raise ValueError(f"positions span {span:g} m, against a wavelength of {lam:.3g} m: "
-                         "metres are expected (millimetres given as metres?)")
-    pos.setflags(write=False)
-    arr.setflags(write=False)
-    freq: Any = f if f.size > 1 else float(f[0])
-    out = arr if f.size > 1 else arr[0]
-    return SampledHologram(out, pos, freq, source, bool(monostatic),
-                           as_polarization(polarization, "polarization"))
+    return pos

@@ -105,13 +105,7 @@ def migration_operator(hologram: Hologram, z: Any, *, medium: Any = None,
     True
     """
     if isinstance(hologram, SampledHologram):   # scattered samples: imaging/samples.py
-        from ..samples import samples_operator
-
-        if settings is not None or sampling != "auto":
-            raise ValueError("scattered samples take options by name (no settings=, "
-                             "sampling=)")
-        return samples_operator(hologram, z, medium=medium,
-                                **{**preset_options(preset), **options})
+        return _of_samples(hologram, z, medium, settings, sampling, preset, options)
     given = dict(options)
     if settings is None:
         given = {**preset_options(preset), **given}
@@ -270,3 +264,13 @@ class MigrationOperator(LinearOperator):
                 f"image {self.image_shape}, backend {self.backend.name!r}, "
                 f"{'' if self.oversampling == 1 else f'sampled 1 in {self.oversampling}, '}"
                 f"{self.dtype}>")
+
+
+def _of_samples(samples: SampledHologram, z: Any, medium: Any, settings: Any, sampling: str,
+                preset: str, options: dict[str, Any]) -> Any:
+    """``migration_operator`` of scattered samples (:func:`..samples.samples_operator`)."""
+    from ..samples import samples_operator
+
+    if settings is not None or sampling != "auto":
+        raise ValueError("scattered samples take options by name (no settings=, sampling=)")
+    return samples_operator(samples, z, medium=medium, **{**preset_options(preset), **options})
